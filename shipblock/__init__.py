@@ -1,0 +1,59 @@
+"""shipblock: seismic response of a free-standing ship on keel blocks.
+
+The physics (all eight modes of motion, transitions, impacts and failure) is in
+:mod:`shipblock.equations`, :mod:`shipblock.impact` and :mod:`shipblock.solver`; ground motions
+in :mod:`shipblock.motion`, :mod:`shipblock.processing`, :mod:`shipblock.scaling` and
+:mod:`shipblock.intensity`; batch runs and fragility in :mod:`shipblock.fragility`.
+"""
+
+from __future__ import annotations
+
+import importlib
+from importlib.metadata import PackageNotFoundError, version
+
+try:
+    __version__ = version("shipblock")
+except PackageNotFoundError:  # running from a source tree that is not installed
+    __version__ = "0+unknown"
+
+from shipblock.modes import EventKind, Failure, Mode
+from shipblock.result import Energy, Event, SimulationResult
+from shipblock.solver import simulate, simulate_batch
+from shipblock.system import ShipBlockSystem, system_restitution
+
+# Heavier parts load on first use (obspy, xarray, scipy.stats).
+_LAZY = {
+    "read_motion": "shipblock.motion",
+    "GroundMotion": "shipblock.motion",
+    "load_catalogue": "shipblock.catalogue",
+    "ShipblockError": "shipblock.errors",
+    "RecordError": "shipblock.errors",
+    "intensity": "shipblock.intensity",
+    "processing": "shipblock.processing",
+    "scaling": "shipblock.scaling",
+    "run_pipeline": "shipblock.fragility.pipeline",
+}
+
+
+def __getattr__(name):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'shipblock' has no attribute {name!r}")
+    mod = importlib.import_module(module)
+    return mod if module.endswith("." + name) else getattr(mod, name)
+
+
+__all__ = [
+    "ShipBlockSystem",
+    "simulate",
+    "simulate_batch",
+    "SimulationResult",
+    "Event",
+    "Energy",
+    "Mode",
+    "EventKind",
+    "Failure",
+    "system_restitution",
+    "__version__",
+    *_LAZY,
+]

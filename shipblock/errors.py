@@ -1,0 +1,42 @@
+"""Error types of shipblock.
+
+Every error that shipblock raises on purpose derives from :class:`ShipblockError`, so callers can
+catch the project's own failures with one ``except`` clause. Record errors also derive from
+:class:`ValueError`, the type that Python code conventionally raises for bad input data.
+"""
+
+from __future__ import annotations
+
+__all__ = ["RecordError", "ShipblockError", "UnitsError"]
+
+
+class ShipblockError(Exception):
+    """Base class of every error raised on purpose by shipblock."""
+
+
+class RecordError(ShipblockError, ValueError):
+    """A ground-motion record cannot be read or used.
+
+    The message always names the file (or ``"<stream>"`` for an in-memory stream) and says what is
+    wrong with it.
+
+    Parameters
+    ----------
+    source : str or os.PathLike
+        The file (or a label for the in-memory data) the problem was found in.
+    problem : str
+        What is wrong, in words a user can act on.
+    """
+
+    def __init__(self, source, problem: str):
+        self.source = str(source)
+        self.problem = problem
+        super().__init__(f"{self.source}: {problem}")
+
+    def __reduce__(self):
+        """Keep the error picklable (for example across Dask workers)."""
+        return (type(self), (self.source, self.problem))
+
+
+class UnitsError(RecordError):
+    """The physical units of a record are unknown, inconsistent or not an acceleration."""

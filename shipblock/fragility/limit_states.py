@@ -1,0 +1,401 @@
+r"""Limit states: named thresholds on the engineering demand parameters (EDPs) of a run.
+
+A limit state (LS) turns the per-run summary of a simulation into a yes/no outcome, for example
+"the ship slipped more than 5 cm on the blocks". Counting these outcomes over records and IM
+levels gives the data that :mod:`shipblock.fragility.fit` turns into fragility curves.
+
+Limit states are declared in the pipeline TOML file::
+
+    [[limit_states]]
+    name = "ship_slip"
+    edp = "peak_ship_slip"
+    threshold = 0.05        # [m]; exceeded when edp > threshold
+    [[limit_states]]
+    name = "any_failure"
+    edp = "failure"
+    condition = "nonzero"
+
+and read with :func:`parse_limit_states`. :func:`exceedance` evaluates one limit state on a
+summary (a mapping of numpy arrays, or an :class:`xarray.Dataset`), with two rules:
+
+* **Collapse exceeds every response limit state.** A run that ended in separation of the ship
+  from the blocks or in overturning of a block (``failure != 0``) is counted as exceeding every
+  limit state defined on a response EDP (everything except ``failure`` itself). The system has
+  collapsed, which is beyond any deformation or rocking level; moreover the solver stops at the
+  failure event, so the peak and residual EDPs of such a run are truncated and would otherwise
+  be read as a *small* response.
+* **Errored runs are missing.** A run whose EDP (or ``failure`` code) is NaN did not produce a
+  result: it is neither exceeded nor not exceeded. :func:`exceedance` returns a ``valid`` mask
+  and such runs must be left out of the counts (not counted as survivors).
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass
+from types import MappingProxyType
+from typing import Any, NamedTuple
+
+import numpy as np
+
+__all__ = [
+    "CONDITIONS",
+    "EDP_VARIABLES",
+    "FAILURE_CODES",
+    "EDPInfo",
+    "Exceedance",
+    "LimitState",
+    "evaluate_limit_states",
+    "exceedance",
+    "parse_limit_states",
+]
+
+#: Meaning of the integer ``failure`` code of a run summary.
+FAILURE_CODES: Mapping[int, str] = MappingProxyType({0: "none", 1: "separation", 2: "overturning"})
+
+
+class EDPInfo(NamedTuple):
+    """Description of one summary variable usable as an EDP.
+
+    Attributes
+    ----------
+    units : str
+        Units of the variable (``"1"`` for dimensionless).
+    long_name : str
+        Human-readable description.
+    kind : str
+        ``"float"`` (continuous, non-negative), ``"count"`` (non-negative integer), ``"bool"`` or
+        ``"code"`` (categorical integer, see :data:`FAILURE_CODES`).
+    response : bool
+        Whether it is a response quantity, so that collapse (``failure != 0``) exceeds every limit
+        state defined on it.
+    magnitude : bool
+        Whether the limit state compares the absolute value (for possibly signed residuals).
+    """
+
+    units: str
+    long_name: str
+    kind: str
+    response: bool
+    magnitude: bool = False
+
+
+#: Summary variables that limit states may refer to. ``failure_time`` [s] is also part of a run
+#: summary but is not an EDP (it is undefined for runs that did not fail).
+EDP_VARIABLES: Mapping[str, EDPInfo] = MappingProxyType(
+    {
+        "peak_block_slip": EDPInfo("m", "peak absolute block slip max|x_b|", "float", True),
+        "peak_ship_slip": EDPInfo("m", "peak absolute ship slip max|x_s|", "float", True),
+        "peak_rotation": EDPInfo("rad", "peak absolute block rotation max|theta|", "float", True),
+        "peak_rotation_ratio": EDPInfo(
+            "1", "peak rotation over critical rotation max|theta|/theta_c", "float", True
+        ),
+        "residual_block_slip": EDPInfo("m", "residual block slip", "float", True, True),
+        "residual_ship_slip": EDPInfo("m", "residual ship slip", "float", True, True),
+        "uplift": EDPInfo("1", "block uplift (rocking) occurred", "bool", True),
+        "n_impacts": EDPInfo("1", "number of rocking impacts", "count", True),
+        "failure": EDPInfo(
+            "1", "failure code (0 none, 1 separation, 2 overturning)", "code", False
+        ),
+    }
+)
+
+#: Conditions a limit state may use, with the EDP kinds each applies to.
+CONDITIONS: Mapping[str, tuple[str, ...]] = MappingProxyType(
+    {
+        "greater": ("float", "count"),  # |edp| > threshold
+        "greater_equal": ("float", "count"),  # |edp| >= threshold
+        "equal": ("count", "code"),  # edp == threshold
+        "nonzero": ("count", "bool", "code"),  # edp != 0
+    }
+)
+
+_NEEDS_THRESHOLD = frozenset({"greater", "greater_equal", "equal"})
+_KEYS = ("name", "edp", "threshold", "condition", "description")
+
+
+@dataclass(frozen=True)
+class LimitState:
+    """A named threshold on one EDP of a run summary.
+
+    Construction does no checking (config objects hold no logic in ``__init__``); call
+    :meth:`validate`, as :func:`parse_limit_states` and :func:`exceedance` do.
+
+    Attributes
+    ----------
+    name : str
+        Unique identifier, e.g. ``"ship_slip"``.
+    edp : str
+        Summary variable, a key of :data:`EDP_VARIABLES`.
+    threshold : float or None
+        Threshold in the units of the EDP (e.g. [m] for ``peak_ship_slip``); ``None`` for
+        ``condition="nonzero"``.
+    condition : str
+        One of :data:`CONDITIONS`: ``"greater"`` (exceeded when ``edp > threshold``, the
+        default), ``"greater_equal"``, ``"equal"`` (e.g. ``failure == 2``: overturning) or
+        ``"nonzero"``. Residual slips are compared by absolute value.
+    description : str
+        Free text, optional.
+    """
+
+    name: str
+    edp: str
+    threshold: float | None = None
+    condition: str = "greater"
+    description: str = ""
+
+    def validate(self) -> LimitState:
+        """Check the definition and return it unchanged.
+
+        Returns
+        -------
+        LimitState
+            ``self``.
+
+        Raises
+        ------
+        ValueError
+            Naming the limit state and the offending field: empty name, unknown EDP, unknown
+            condition or one that does not apply to the EDP, missing, superfluous, non-numeric,
+            non-finite or negative threshold, or a failure code that does not exist.
+        """
+        who = f"limit state {self.name!r}"
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise ValueError(f"limit state name must be a non-empty string, got {self.name!r}")
+        if self.edp not in EDP_VARIABLES:
+            hint = (
+                " (failure_time is not an EDP; use edp = 'failure')"
+                if self.edp == "failure_time"
+                else ""
+            )
+            raise ValueError(
+                f"{who}: unknown edp {self.edp!r}{hint}; known EDPs: {', '.join(EDP_VARIABLES)}"
+            )
+        if self.condition not in CONDITIONS:
+            raise ValueError(
+                f"{who}: unknown condition {self.condition!r}; use one of {', '.join(CONDITIONS)}"
+            )
+        info = EDP_VARIABLES[self.edp]
+        if info.kind not in CONDITIONS[self.condition]:
+            usable = [c for c, kinds in CONDITIONS.items() if info.kind in kinds]
+            raise ValueError(
+                f"{who}: condition {self.condition!r} does not apply to {info.kind} EDP "
+                f"{self.edp!r}; use one of {', '.join(usable)}"
+            )
+        if self.condition not in _NEEDS_THRESHOLD:
+            if self.threshold is not None:
+                raise ValueError(
+                    f"{who}: threshold is not used with condition {self.condition!r}; remove it"
+                )
+            return self
+        t = self.threshold
+        if t is None:
+            raise ValueError(f"{who}: missing threshold (condition {self.condition!r})")
+        if isinstance(t, bool) or not isinstance(t, numbers.Real) or not math.isfinite(t):
+            raise ValueError(f"{who}: threshold must be a finite number, got {t!r}")
+        if info.kind == "code":
+            if t not in FAILURE_CODES or t == 0:
+                raise ValueError(
+                    f"{who}: threshold {t!r} is not a failure code; use 1 (separation) or "
+                    "2 (overturning)"
+                )
+        elif t < 0:
+            raise ValueError(
+                f"{who}: threshold {t!r} [{info.units}] is negative but {self.edp!r} is compared "
+                "as a non-negative magnitude"
+            )
+        return self
+
+    def to_dict(self) -> dict[str, Any]:
+        """Return the TOML-ready dictionary (``None`` and empty fields left out)."""
+        return {k: v for k, v in asdict(self).items() if v is not None and v != ""}
+
+
+def parse_limit_states(entries: Sequence[Mapping[str, Any]]) -> tuple[LimitState, ...]:
+    """Build validated limit states from the ``[[limit_states]]`` tables of a pipeline file.
+
+    Parameters
+    ----------
+    entries : sequence of mappings
+        For example ``tomllib.load(f)["limit_states"]``. Keys: ``name`` and ``edp``
+        (required), ``threshold``, ``condition`` (default ``"greater"``), ``description``.
+
+    Returns
+    -------
+    tuple of LimitState
+        In the order given.
+
+    Raises
+    ------
+    ValueError
+        With the index and name of the offending entry: not a table, unknown key, missing
+        ``name``/``edp``, duplicate name, or any check of :meth:`LimitState.validate`.
+    """
+    if isinstance(entries, (str, bytes, Mapping)) or not isinstance(entries, Sequence):
+        raise ValueError(
+            "limit_states must be a list of tables ([[limit_states]] in TOML), got "
+            f"{type(entries).__name__}"
+        )
+    out: list[LimitState] = []
+    seen: dict[str, int] = {}
+    for i, entry in enumerate(entries):
+        where = f"limit_states[{i}]"
+        if not isinstance(entry, Mapping):
+            raise ValueError(f"{where}: expected a table, got {type(entry).__name__}")
+        if "name" in entry:
+            where += f" ({entry['name']!r})"
+        unknown = sorted(set(entry) - set(_KEYS))
+        if unknown:
+            raise ValueError(
+                f"{where}: unknown key(s) {', '.join(map(repr, unknown))}; allowed keys: "
+                f"{', '.join(_KEYS)}"
+            )
+        for key in ("name", "edp"):
+            if key not in entry:
+                raise ValueError(f"{where}: missing required key {key!r}")
+        ls = LimitState(
+            name=entry["name"],
+            edp=entry["edp"],
+            threshold=entry.get("threshold"),
+            condition=entry.get("condition", "greater"),
+            description=entry.get("description", ""),
+        )
+        try:
+            ls.validate()
+        except ValueError as err:
+            raise ValueError(f"{where}: {err}") from None
+        if ls.name in seen:
+            raise ValueError(
+                f"{where}: duplicate limit state name {ls.name!r} (first defined in "
+                f"limit_states[{seen[ls.name]}])"
+            )
+        seen[ls.name] = i
+        out.append(ls)
+    return tuple(out)
+
+
+class Exceedance(NamedTuple):
+    """Outcome of one limit state over a set of runs.
+
+    Attributes
+    ----------
+    exceeded : numpy.ndarray or xarray.DataArray of bool
+        Whether each run exceeded the limit state (``False`` where not ``valid``).
+    valid : numpy.ndarray or xarray.DataArray of bool
+        Whether the run produced a usable result (``False`` for errored runs, whose EDP or
+        failure code is NaN). Count only valid runs.
+    """
+
+    exceeded: Any
+    valid: Any
+
+
+def _get(summary, key, ls_name):
+    try:
+        value = summary[key]
+    except KeyError:
+        raise KeyError(
+            f"limit state {ls_name!r} needs summary variable {key!r}, which is missing"
+        ) from None
+    return value if hasattr(value, "dims") else np.asarray(value)
+
+
+def exceedance(limit_state: LimitState, summary) -> Exceedance:
+    r"""Evaluate a limit state on per-run summary variables.
+
+    .. math::
+
+        e = \begin{cases}
+            \text{undefined (invalid)} & \text{EDP or failure code is NaN} \\
+            \text{true} & \text{failure} \ne 0 \text{ and the EDP is a response quantity} \\
+            \lvert \mathrm{EDP} \rvert > t & \text{condition ``greater''}, \dots
+        \end{cases}
+
+    Parameters
+    ----------
+    limit_state : LimitState
+        The limit state (validated here).
+    summary : Mapping[str, array_like] or xarray.Dataset
+        Per-run summary variables (see :data:`EDP_VARIABLES`), all of the same shape (or, for
+        xarray, broadcastable dims). Must contain ``limit_state.edp`` and, for response EDPs,
+        ``failure``.
+
+    Returns
+    -------
+    Exceedance
+        ``exceeded`` and ``valid`` boolean arrays with the shape of the EDP (DataArrays with
+        its dims and coords for xarray input). ``exceeded`` is ``False`` wherever ``valid`` is
+        ``False``.
+
+    Raises
+    ------
+    KeyError
+        If a needed summary variable is missing. ``failure`` is required for response EDPs
+        because, without it, collapsed runs (whose EDPs stop at the failure time) would be
+        silently counted as small responses.
+    ValueError
+        If the limit state is invalid or numpy arrays differ in shape.
+
+    Notes
+    -----
+    A run with ``failure != 0`` (separation or overturning) exceeds every response limit state
+    even if its EDP is NaN: the collapse is known, and it is beyond any deformation level. For
+    ``edp = "failure"`` the condition is applied to the code itself (so ``equal 2`` is exceeded
+    only by overturning).
+    """
+    ls = limit_state.validate()
+    info = EDP_VARIABLES[ls.edp]
+    value = _get(summary, ls.edp, ls.name)
+    missing = value != value  # NaN test that also works on int/bool arrays and DataArrays
+    v = abs(value) if info.magnitude else value
+    if ls.condition == "greater":
+        raw = v > ls.threshold
+    elif ls.condition == "greater_equal":
+        raw = v >= ls.threshold
+    elif ls.condition == "equal":
+        raw = v == ls.threshold
+    else:  # nonzero
+        raw = (v != 0) & ~missing
+    if info.response:
+        failure = _get(summary, "failure", ls.name)
+        if not hasattr(value, "dims") and np.shape(failure) != np.shape(value):
+            raise ValueError(
+                f"summary variables {ls.edp!r} {np.shape(value)} and 'failure' "
+                f"{np.shape(failure)} differ in shape"
+            )
+        failure_missing = failure != failure
+        collapsed = (failure != 0) & ~failure_missing
+        valid = (~missing | collapsed) & ~failure_missing
+        exceeded = (raw | collapsed) & valid
+    else:
+        valid = ~missing
+        exceeded = raw & valid
+    if hasattr(exceeded, "attrs"):
+        exceeded = exceeded.rename(ls.name)
+        exceeded.attrs = {
+            "long_name": f"exceedance of limit state {ls.name}",
+            **{f"limit_state_{k}": v for k, v in ls.to_dict().items() if k != "name"},
+        }
+        valid = valid.rename(f"{ls.name}_valid")
+        valid.attrs = {"long_name": f"run usable for limit state {ls.name}"}
+    return Exceedance(exceeded=exceeded, valid=valid)
+
+
+def evaluate_limit_states(limit_states, summary) -> dict[str, Exceedance]:
+    """Evaluate several limit states on the same summary.
+
+    Parameters
+    ----------
+    limit_states : iterable of LimitState
+        E.g. the output of :func:`parse_limit_states`.
+    summary : Mapping[str, array_like] or xarray.Dataset
+        Per-run summary variables, see :func:`exceedance`.
+
+    Returns
+    -------
+    dict[str, Exceedance]
+        Keyed by limit state name, in input order.
+    """
+    return {ls.name: exceedance(ls, summary) for ls in limit_states}

@@ -1,0 +1,193 @@
+"""Result of one simulation: time histories, events, failure, energy, summary."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from shipblock.modes import FAILURE_NAMES, MODE_DESCRIPTIONS, EventKind
+
+
+@dataclass(frozen=True)
+class Event:
+    """One located event.
+
+    Attributes
+    ----------
+    time : float
+        Time of the event [s], located to about 1e-12 s.
+    kind : str
+        What happened (an :class:`~shipblock.modes.EventKind` name in lower case, for example
+        ``"uplift"``, ``"impact"``, ``"ground_slip_start"``, ``"overturning"``).
+    from_mode, to_mode : int
+        Mode before and after (0 after a failure).
+    """
+
+    time: float
+    kind: str
+    from_mode: int
+    to_mode: int
+
+
+@dataclass(frozen=True)
+class Energy:
+    """Energy bookkeeping at the input samples [J].
+
+    The balance :math:`T + V - (T_0 + V_0) = W_{in} - D - E_{imp}` holds to the integration
+    accuracy; :attr:`residual` is its left side minus its right side.
+
+    Attributes
+    ----------
+    input_work : ndarray
+        Work of the inertial forces of the ground motion, :math:`\\int -(a P_x + \\ddot y_g P_y)\\,dt`.
+    kinetic : ndarray
+        Kinetic energy relative to the ground :math:`T`.
+    potential : ndarray
+        Gravity potential above the rest position :math:`V = (nm+2M) g R (\\cos\\varphi - \\cos\\theta_c)`.
+    friction : ndarray
+        Energy dissipated by friction :math:`D = \\int -(f_x\\dot x_b + F_x\\dot x_s)\\,dt`.
+    impact : ndarray
+        Kinetic energy lost in impacts :math:`E_{imp}`.
+    """
+
+    input_work: np.ndarray
+    kinetic: np.ndarray
+    potential: np.ndarray
+    friction: np.ndarray
+    impact: np.ndarray
+
+    @property
+    def residual(self) -> np.ndarray:
+        """Energy-balance residual at the samples [J]."""
+        mech = self.kinetic + self.potential
+        return (mech - mech[0]) - (self.input_work - self.friction - self.impact)
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """Response of the ship-block system to one ground motion.
+
+    All arrays are at the input samples ``t_k = k dt``; after a failure they are NaN and
+    ``mode`` is 0.
+
+    Attributes
+    ----------
+    time : ndarray
+        Sample times [s].
+    x_b, theta, x_s : ndarray
+        Block slip relative to the ground [m], block rotation (counter-clockwise) [rad], ship slip
+        relative to the blocks [m].
+    v_b, theta_dot, v_s : ndarray
+        Their rates [m/s, rad/s, m/s].
+    mode : ndarray of int
+        Active mode (paper numbering 1..8) at each sample.
+    events : list of Event
+        Every located event, in time order (the first is the start).
+    failure : str or None
+        ``None``, ``"separation"``, ``"overturning"`` or ``"solver_error"``.
+    failure_time : float or None
+        Time of the failure [s].
+    energy : Energy
+        Energy bookkeeping.
+    summary : dict
+        Peak and residual displacements, time per mode, number of impacts, etc.
+    system : ShipBlockSystem
+        The system simulated.
+    ground_acceleration : tuple of ndarray
+        ``(ax, ay)`` as used (scaled) [m/s^2].
+    """
+
+    time: np.ndarray
+    x_b: np.ndarray
+    theta: np.ndarray
+    x_s: np.ndarray
+    v_b: np.ndarray
+    theta_dot: np.ndarray
+    v_s: np.ndarray
+    mode: np.ndarray
+    events: list
+    failure: str | None
+    failure_time: float | None
+    energy: Energy
+    summary: dict
+    system: object
+    ground_acceleration: tuple = field(repr=False)
+    options: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def dt(self) -> float:
+        """Sample interval [s]."""
+        return float(self.time[1] - self.time[0]) if self.time.size > 1 else 0.0
+
+    def events_of(self, kind: str) -> list:
+        """The events of one kind (for example ``"impact"``)."""
+        return [e for e in self.events if e.kind == kind]
+
+    def to_dataset(self):
+        """The result as an :class:`xarray.Dataset` with units and long names.
+
+        Returns
+        -------
+        xarray.Dataset
+            Dimension ``time`` for the histories and ``event`` for the event log; the system
+            parameters, failure and summary are global attributes.
+        """
+        import xarray as xr
+
+        from shipblock import __version__
+
+        def var(values, units, long_name, dims=("time",)):
+            return xr.Variable(dims, values, attrs={"units": units, "long_name": long_name})
+
+        ax, ay = self.ground_acceleration
+        ds = xr.Dataset(
+            {
+                "ground_acceleration_h": var(ax, "m/s^2", "horizontal ground acceleration"),
+                "ground_acceleration_v": var(ay, "m/s^2", "vertical ground acceleration"),
+                "x_b": var(self.x_b, "m", "block slip relative to the ground"),
+                "theta": var(self.theta, "rad", "block rotation, counter-clockwise"),
+                "x_s": var(self.x_s, "m", "ship slip relative to the blocks"),
+                "v_b": var(self.v_b, "m/s", "block slip velocity"),
+                "theta_dot": var(self.theta_dot, "rad/s", "block angular velocity"),
+                "v_s": var(self.v_s, "m/s", "ship slip velocity relative to the blocks"),
+                "mode": var(self.mode.astype(np.int8), "1", "mode of motion (paper numbering, 0 = stopped)"),
+                "input_work": var(self.energy.input_work, "J", "work of the ground motion"),
+                "kinetic_energy": var(self.energy.kinetic, "J", "kinetic energy relative to the ground"),
+                "potential_energy": var(self.energy.potential, "J", "gravity potential energy"),
+                "friction_dissipation": var(self.energy.friction, "J", "energy dissipated by friction"),
+                "impact_loss": var(self.energy.impact, "J", "kinetic energy lost in impacts"),
+                "event_time": var(np.array([e.time for e in self.events]), "s", "event time", ("event",)),
+                "event_kind": var(np.array([e.kind for e in self.events], dtype=str), "1", "event kind", ("event",)),
+                "event_from_mode": var(np.array([e.from_mode for e in self.events], dtype=np.int8), "1", "mode before the event", ("event",)),
+                "event_to_mode": var(np.array([e.to_mode for e in self.events], dtype=np.int8), "1", "mode after the event", ("event",)),
+            },
+            coords={"time": ("time", self.time, {"units": "s", "long_name": "time"})},
+        )
+        ds["mode"].attrs["flag_values"] = np.arange(9, dtype=np.int8)
+        ds["mode"].attrs["flag_meanings"] = " ".join(
+            MODE_DESCRIPTIONS[m].replace(" ", "_").replace(",", "") for m in range(9)
+        )
+        ds.attrs["title"] = "shipblock simulation"
+        ds.attrs["shipblock_version"] = __version__
+        ds.attrs["failure"] = self.failure or "none"
+        ds.attrs["failure_time_s"] = np.nan if self.failure_time is None else self.failure_time
+        for key, value in self.system.to_dict().items():
+            ds.attrs[f"system_{key}"] = "None" if value is None else value
+        ds.attrs["restitution_used"] = self.system.effective_restitution
+        for key, value in self.summary.items():
+            if np.isscalar(value) and not isinstance(value, str):
+                ds.attrs[f"summary_{key}"] = float(value)
+        for key, value in self.options.items():
+            ds.attrs[f"solver_{key}"] = value
+        return ds
+
+
+def event_kind_name(code: int) -> str:
+    """Lower-case name of an event code."""
+    return EventKind(int(code)).name.lower()
+
+
+def failure_name(code: int) -> str | None:
+    """Failure name of a failure code (None for 0)."""
+    return FAILURE_NAMES[int(code)]

@@ -1,0 +1,849 @@
+"""Compiled event-driven integration of the ship-block system.
+
+One loop serves every mode. Between two input samples the ground acceleration is linear in
+time; the loop advances the state with Dormand-Prince 5(4) steps that never cross a sample, so
+rest and sliding phases are exact and rocking phases are error-controlled. After every step the
+event functions (one per constraint of the current mode, see ``EV_*``) are checked; when one
+changes sign its root is located by the Illinois method on the step length, the state is
+advanced to the root, the event is applied, and the next mode is chosen among all candidate
+modes consistent with the velocities by :func:`select_mode`.
+
+Nothing here allocates per step; the kernels take only arrays and scalars.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from shipblock.equations import (
+    I_FX,
+    I_FY,
+    I_SFX,
+    I_SFY,
+    N_SOLVE_OUT,
+    input_power,
+    kinetic_energy,
+    potential_energy,
+    solve_mode,
+)
+from shipblock.impact import apply_impact
+from shipblock.modes import MODE_NUMBER, EventKind, Failure
+from shipblock.solver._dopri import DP_A, DP_C, DP_E, DP_ERROR_ORDER
+from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R, P_THC
+
+# State vector.
+Y_XB, Y_TH, Y_XS, Y_VB, Y_OM, Y_VS, Y_WIN, Y_DIS, Y_IMP = 0, 1, 2, 3, 4, 5, 6, 7, 8
+N_STATE = 9  # the last three accumulate input work, friction dissipation and impact loss [J]
+N_DYN = 6  # components under error control
+
+# Mode state vector: interface flags and signs.
+MS_SLIP1, MS_ROCK, MS_SLIP2, MS_S, MS_SIG1, MS_SIG2 = 0, 1, 2, 3, 4, 5
+
+# Event functions; each is >= 0 while its constraint holds.
+EV_G_STICK = 0  # blocks stick on the ground: mu_s1 fy - |fx|
+EV_G_SLIP = 1  # blocks slide: sigma1 * v_b
+EV_UPLIFT = 2  # blocks at rest: B (fy + Fy) - H |fx + Fx|
+EV_IMPACT = 3  # rocking: s * theta
+EV_OVERTURN = 4  # rocking: theta_c - s * theta
+EV_S_STICK = 5  # ship sticks: mu_s2 Fy - |Fx|
+EV_S_SLIP = 6  # ship slides: sigma2 * v_s
+EV_SEP_G = 7  # fy > 0
+EV_SEP_S = 8  # Fy > 0
+N_EVENTS = 9
+#: Order in which simultaneous events are taken: failures first, then velocity events.
+EVENT_PRIORITY = np.array(
+    [EV_SEP_G, EV_SEP_S, EV_OVERTURN, EV_IMPACT, EV_G_SLIP, EV_S_SLIP, EV_UPLIFT, EV_G_STICK,
+     EV_S_STICK],
+    dtype=np.int64,
+)
+
+# Summary vector of one run.
+S_PEAK_XB = 0
+S_PEAK_TH = 1
+S_PEAK_XS = 2
+S_RES_XB = 3
+S_RES_XS = 4
+S_UPLIFT = 5
+S_N_IMPACTS = 6
+S_FAILURE = 7
+S_FAILURE_TIME = 8
+S_MODE_TIME = 9  # 8 entries, modes 1..8
+S_END_TIME = 17
+S_N_EVENTS = 18
+S_W_IN = 19
+S_DISSIPATED = 20
+S_IMPACT_LOSS = 21
+S_N_FALLBACK = 22
+S_ENERGY_FINAL = 23  # T + V at the end
+S_PEAK_TH_TIME = 24
+N_SUMMARY = 25
+
+# Numerical constants (documented in docs/theory/solver.md).
+ROOT_TIME_TOL = 1e-12  # [s] width of the bracket that locates an event
+ONE_SIDED_DT = 1e-8  # [s] candidate modes are checked this long after an event
+FORCE_TOL = 1e-10  # [-] tolerance on force margins, relative to the weight
+ACC_TOL = 1e-10  # [-] a new motion must accelerate by more than this times g
+REARM_TOL = 1e-9  # [-] a disarmed event is re-armed once its function exceeds this
+MIN_STEP = 1e-13  # [s] smallest rocking step before the run is declared failed
+MAX_EVENTS_PER_SAMPLE = 20000  # guards against chattering
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 5.0
+
+
+@njit(cache=True)
+def ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt):
+    """Scaled ground acceleration (a, ay) at t_k + tau, linear between samples [m/s^2]."""
+    n = ax.shape[0]
+    while tau > dt and k < n - 2:
+        tau -= dt
+        k += 1
+    if k >= n - 1:
+        a = ax[n - 1]
+        b = ay[n - 1] if has_ay else 0.0
+        return sh * a, sv * b
+    f = tau / dt
+    a = ax[k] + (ax[k + 1] - ax[k]) * f
+    b = 0.0
+    if has_ay:
+        b = ay[k] + (ay[k + 1] - ay[k]) * f
+    return sh * a, sv * b
+
+
+@njit(cache=True)
+def rhs(p, ms, y, a, ay, dy, w7):
+    """Time derivative of the state in the mode ``ms``; returns False if singular."""
+    rock = ms[MS_ROCK]
+    ok = solve_mode(
+        p, ms[MS_SLIP1], rock, ms[MS_SLIP2], float(ms[MS_S]), float(ms[MS_SIG1]),
+        float(ms[MS_SIG2]), y[Y_TH], y[Y_OM], a, p[P_G] + ay, w7,
+    )
+    dy[Y_XB] = y[Y_VB]
+    dy[Y_TH] = y[Y_OM]
+    dy[Y_XS] = y[Y_VS]
+    dy[Y_VB] = w7[0]
+    dy[Y_OM] = w7[1]
+    dy[Y_VS] = w7[2]
+    dy[Y_WIN] = input_power(
+        p, y[Y_TH], float(ms[MS_S]), rock, y[Y_VB], y[Y_OM], y[Y_VS], a, ay
+    )
+    dy[Y_DIS] = -(w7[I_FX] * y[Y_VB] + w7[I_SFX] * y[Y_VS])
+    dy[Y_IMP] = 0.0
+    return ok
+
+
+@njit(cache=True)
+def is_static(ms, y):
+    """True in mode 1 with all velocities zero: the state does not change."""
+    return (
+        ms[MS_SLIP1] == 0 and ms[MS_ROCK] == 0 and ms[MS_SLIP2] == 0
+        and y[Y_VB] == 0.0 and y[Y_OM] == 0.0 and y[Y_VS] == 0.0
+    )
+
+
+@njit(cache=True)
+def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7):
+    """Advance ``y0`` by ``h`` within sample interval ``k``; returns the error norm or -1.
+
+    The error norm is only meaningful in rocking modes (it is zero up to round-off in the
+    others, whose solutions are polynomials integrated exactly).
+    """
+    n = y0.shape[0]
+    if is_static(ms, y0) or h == 0.0:
+        for i in range(n):
+            y1[i] = y0[i]
+        return 0.0
+    for st in range(7):
+        for i in range(n):
+            acc = y0[i]
+            for j in range(st):
+                acc += h * DP_A[st, j] * stages[j, i]
+            ytmp[i] = acc
+        a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + DP_C[st] * h, dt)
+        if not rhs(p, ms, ytmp, a, b, stages[st], w7):
+            return -1.0
+    for i in range(n):
+        y1[i] = ytmp[i]  # the 7th stage point is the 5th-order solution (FSAL)
+    return 0.0
+
+
+@njit(cache=True)
+def error_norm(y0, y1, stages, h, rtol, atol):
+    """RMS of the embedded error estimate scaled by atol + rtol*|y| over the dynamic states."""
+    acc = 0.0
+    for i in range(N_DYN):
+        e = 0.0
+        for st in range(7):
+            e += DP_E[st] * stages[st, i]
+        e *= h
+        sc = atol + rtol * max(abs(y0[i]), abs(y1[i]))
+        acc += (e / sc) ** 2
+    return math.sqrt(acc / N_DYN)
+
+
+@njit(cache=True)
+def event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g, w7):
+    """Fill ``g`` with the event functions at (t_k + tau, y); ``w7`` gets accelerations/forces."""
+    a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)
+    ok = solve_mode(
+        p, ms[MS_SLIP1], ms[MS_ROCK], ms[MS_SLIP2], float(ms[MS_S]), float(ms[MS_SIG1]),
+        float(ms[MS_SIG2]), y[Y_TH], y[Y_OM], a, p[P_G] + b, w7,
+    )
+    weight = (p[P_NM] + p[P_M]) * p[P_G]
+    ship_weight = p[P_M] * p[P_G]
+    fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
+    for e in range(N_EVENTS):
+        g[e] = 1.0
+    if ms[MS_SLIP1]:
+        g[EV_G_SLIP] = ms[MS_SIG1] * y[Y_VB]
+    else:
+        g[EV_G_STICK] = (p[P_MUS1] * fy - abs(fx)) / weight
+    if ms[MS_ROCK]:
+        g[EV_IMPACT] = ms[MS_S] * y[Y_TH]
+        g[EV_OVERTURN] = p[P_THC] - ms[MS_S] * y[Y_TH]
+    else:
+        g[EV_UPLIFT] = (p[P_B] * (fy + Fy) - p[P_H] * abs(fx + Fx)) / (weight * p[P_R])
+    if ms[MS_SLIP2]:
+        g[EV_S_SLIP] = ms[MS_SIG2] * y[Y_VS]
+    else:
+        g[EV_S_STICK] = (p[P_MUS2] * Fy - abs(Fx)) / ship_weight
+    g[EV_SEP_G] = fy / weight
+    g[EV_SEP_S] = Fy / ship_weight
+    return ok
+
+
+@njit(cache=True)
+def event_slope(e, ms, y, w7):
+    """Time derivative of the velocity-type event functions (0 for the others)."""
+    if e == EV_G_SLIP:
+        return ms[MS_SIG1] * w7[0]
+    if e == EV_S_SLIP:
+        return ms[MS_SIG2] * w7[2]
+    if e == EV_IMPACT:
+        return ms[MS_S] * y[Y_OM]
+    return 0.0
+
+
+@njit(cache=True)
+def has_slope(e):
+    return e == EV_G_SLIP or e == EV_S_SLIP or e == EV_IMPACT
+
+
+@njit(cache=True)
+def hermite_extremum(g0, d0, g1, d1):
+    """Interior extremum of the cubic Hermite interpolant on [0, 1]: (u, value) or (-1, 0).
+
+    ``d0`` and ``d1`` are the end slopes scaled to the unit interval.
+    """
+    # p(u) = g0 + d0 u + c2 u^2 + c3 u^3
+    c2 = 3.0 * (g1 - g0) - 2.0 * d0 - d1
+    c3 = 2.0 * (g0 - g1) + d0 + d1
+    # p'(u) = d0 + 2 c2 u + 3 c3 u^2
+    qa, qb, qc = 3.0 * c3, 2.0 * c2, d0
+    best_u = -1.0
+    best_v = 0.0
+    if abs(qa) < 1e-300:
+        if qb != 0.0:
+            u = -qc / qb
+            if 0.0 < u < 1.0:
+                best_u = u
+    else:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc >= 0.0:
+            sq = math.sqrt(disc)
+            for u in ((-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)):
+                if 0.0 < u < 1.0:
+                    v = g0 + d0 * u + c2 * u * u + c3 * u * u * u
+                    if best_u < 0.0 or (d0 < 0.0 and v < best_v) or (d0 > 0.0 and v > best_v):
+                        best_u = u
+                        best_v = v
+    if best_u >= 0.0:
+        u = best_u
+        best_v = g0 + d0 * u + c2 * u * u + c3 * u * u * u
+    return best_u, best_v
+
+
+@njit(cache=True)
+def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g):
+    """Event function ``e`` after advancing ``y0`` by ``h`` (state left in ``y1``)."""
+    advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
+    event_values(p, ms, y1, k, tau + h, dt, ax, ay, has_ay, sh, sv, g, w7)
+    return g[e]
+
+
+@njit(cache=True)
+def locate_root(e, lo, g_lo, hi, g_hi, p, ms, y0, k, tau, dt, ax, ay, has_ay, sh, sv,
+                y1, stages, ytmp, w7, g):
+    """Illinois iteration for the step length at which event ``e`` crosses zero.
+
+    ``g_lo >= 0 > g_hi``. Returns the violated end of the final bracket (width
+    <= ROOT_TIME_TOL), so the event has just happened there.
+    """
+    side = 0
+    for _ in range(200):
+        if hi - lo <= ROOT_TIME_TOL:
+            break
+        if g_lo == g_hi:
+            mid = 0.5 * (lo + hi)
+        else:
+            mid = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+        # keep the trial strictly inside, and fall back to bisection near the ends
+        width = hi - lo
+        if not (lo + 0.01 * width < mid < hi - 0.01 * width):
+            mid = 0.5 * (lo + hi)
+        gm = event_after(e, p, ms, y0, k, tau, mid, dt, ax, ay, has_ay, sh, sv,
+                         y1, stages, ytmp, w7, g)
+        if gm < 0.0:
+            hi, g_hi = mid, gm
+            if side == -1:
+                g_lo *= 0.5
+            side = -1
+        else:
+            lo, g_lo = mid, gm
+            if side == 1:
+                g_hi *= 0.5
+            side = 1
+    return hi
+
+
+@njit(cache=True)
+def mode_number_of(slip1, rock, slip2):
+    """Paper mode number (1..8) of the three interface flags."""
+    return MODE_NUMBER[slip1, rock, slip2]
+
+
+@njit(cache=True)
+def mode_number(ms):
+    """Paper mode number (1..8) of a mode state vector."""
+    return mode_number_of(ms[MS_SLIP1], ms[MS_ROCK], ms[MS_SLIP2])
+
+
+@njit(cache=True)
+def rotation_extremum(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7):
+    """|theta| at the instant inside a rocking step where theta_dot changes sign.
+
+    Illinois iteration on the step length for theta_dot = 0, so peak rotations do not depend on
+    where the steps happen to end.
+    """
+    lo, hi = 0.0, h
+    w_lo = y0[Y_OM]
+    advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
+    w_hi = y1[Y_OM]
+    best = abs(y1[Y_TH])
+    side = 0
+    for _ in range(100):
+        if hi - lo <= ROOT_TIME_TOL:
+            break
+        mid = hi - w_hi * (hi - lo) / (w_hi - w_lo)
+        width = hi - lo
+        if not (lo + 0.01 * width < mid < hi - 0.01 * width):
+            mid = 0.5 * (lo + hi)
+        advance(p, ms, y0, k, tau, mid, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
+        wm = y1[Y_OM]
+        best = max(best, abs(y1[Y_TH]))
+        if (wm > 0.0) == (w_hi > 0.0):
+            hi, w_hi = mid, wm
+            if side == -1:
+                w_lo *= 0.5
+            side = -1
+        else:
+            lo, w_lo = mid, wm
+            if side == 1:
+                w_hi *= 0.5
+            side = 1
+    return best
+
+
+@njit(cache=True)
+def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
+    """Choose the next mode among the candidates consistent with the velocities.
+
+    Candidates: an interface with a nonzero slip velocity keeps slipping that way; one at zero
+    velocity may stick or start slipping either way; a block with theta != 0 (or theta_dot != 0
+    after an impact) rocks on the pivot given by that sign; one at rest may stay or start rocking
+    on either corner. Each candidate is evaluated ONE_SIDED_DT after the event and is consistent
+    when stick forces lie inside their static friction cones, the block-rest moment criterion
+    holds, new motions accelerate in their assumed direction and both normal forces are positive.
+    Among consistent candidates the one with the fewest new motions wins; ties go to the one
+    releasing ``trigger`` (0 ground, 1 rocking, 2 ship), then to the lower paper mode number.
+
+    Returns
+    -------
+    status : int
+        0 a consistent mode was chosen, 1 none was consistent and the least-violating was
+        taken, 2 every candidate had a non-positive normal force (separation).
+    """
+    a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + ONE_SIDED_DT, dt)
+    G = p[P_G] + b
+    weight = (p[P_NM] + p[P_M]) * p[P_G]
+    ship_weight = p[P_M] * p[P_G]
+    vb, th, om, vs = y[Y_VB], y[Y_TH], y[Y_OM], y[Y_VS]
+    best_key0 = 3
+    best_key1 = 1e300
+    best_key2 = 2
+    best_mode = 99
+    best = np.zeros(6, dtype=np.int64)
+    all_separate = True
+    # option lists: (flag, sign)
+    for i1 in range(3):
+        if vb != 0.0:
+            if i1 > 0:
+                continue
+            slip1, sig1 = 1, (1 if vb > 0.0 else -1)
+            new1 = 0
+        else:
+            slip1 = 0 if i1 == 0 else 1
+            sig1 = -1 if i1 == 2 else 1
+            new1 = slip1
+        for ir in range(3):
+            if th != 0.0 or om != 0.0:
+                if ir > 0:
+                    continue
+                rock = 1
+                ref = th if th != 0.0 else om
+                s = 1 if ref > 0.0 else -1
+                newr = 0
+            else:
+                rock = 0 if ir == 0 else 1
+                s = -1 if ir == 2 else 1
+                newr = rock
+            for i2 in range(3):
+                if vs != 0.0:
+                    if i2 > 0:
+                        continue
+                    slip2, sig2 = 1, (1 if vs > 0.0 else -1)
+                    new2 = 0
+                else:
+                    slip2 = 0 if i2 == 0 else 1
+                    sig2 = -1 if i2 == 2 else 1
+                    new2 = slip2
+                ok = solve_mode(p, slip1, rock, slip2, float(s), float(sig1), float(sig2),
+                                th, om, a, G, w7)
+                if not ok:
+                    continue
+                fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
+                viol = 0.0
+                separate = fy <= 0.0 or Fy <= 0.0
+                if not separate:
+                    all_separate = False
+                else:
+                    viol += max(0.0, -fy / weight) + max(0.0, -Fy / ship_weight) + 1.0
+                if slip1 == 0:
+                    v = (abs(fx) - p[P_MUS1] * fy) / weight
+                    if v > FORCE_TOL:
+                        viol += v
+                elif new1:
+                    v = sig1 * w7[0] / p[P_G]
+                    if v <= ACC_TOL:
+                        viol += ACC_TOL - v
+                if rock == 0:
+                    v = (p[P_H] * abs(fx + Fx) - p[P_B] * (fy + Fy)) / (weight * p[P_R])
+                    if v > FORCE_TOL:
+                        viol += v
+                elif newr:
+                    v = s * w7[1] * p[P_R] / p[P_G]
+                    if v <= ACC_TOL:
+                        viol += ACC_TOL - v
+                if slip2 == 0:
+                    v = (abs(Fx) - p[P_MUS2] * Fy) / ship_weight
+                    if v > FORCE_TOL:
+                        viol += v
+                elif new2:
+                    v = sig2 * w7[2] / p[P_G]
+                    if v <= ACC_TOL:
+                        viol += ACC_TOL - v
+                n_new = new1 + newr + new2
+                if trigger == 0:
+                    releases = new1
+                elif trigger == 1:
+                    releases = newr
+                elif trigger == 2:
+                    releases = new2
+                else:
+                    releases = 0
+                mode = mode_number_of(slip1, rock, slip2)
+                if viol == 0.0:
+                    key0, key1 = 0, float(n_new)
+                else:
+                    key0, key1 = 1, viol
+                key2 = 0 if releases else 1
+                better = False
+                if key0 < best_key0:
+                    better = True
+                elif key0 == best_key0:
+                    if key1 < best_key1:
+                        better = True
+                    elif key1 == best_key1:
+                        if key2 < best_key2:
+                            better = True
+                        elif key2 == best_key2 and mode < best_mode:
+                            better = True
+                if better:
+                    best_key0, best_key1, best_key2, best_mode = key0, key1, key2, mode
+                    best[0], best[1], best[2] = slip1, rock, slip2
+                    best[3], best[4], best[5] = s, sig1, sig2
+    if all_separate:
+        return 2
+    for i in range(6):
+        ms[i] = best[i]
+    return 0 if best_key0 == 0 else 1
+
+
+@njit(cache=True)
+def _grow(arr_t, arr_k, arr_f, arr_to, n):
+    if n < arr_t.shape[0]:
+        return arr_t, arr_k, arr_f, arr_to
+    m = 2 * arr_t.shape[0] + 16
+    t2 = np.empty(m)
+    k2 = np.empty(m, dtype=np.int64)
+    f2 = np.empty(m, dtype=np.int64)
+    to2 = np.empty(m, dtype=np.int64)
+    t2[:n] = arr_t[:n]
+    k2[:n] = arr_k[:n]
+    f2[:n] = arr_f[:n]
+    to2[:n] = arr_to[:n]
+    return t2, k2, f2, to2
+
+
+@njit(cache=True)
+def run(p, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes, summary, y_init):
+    """Integrate one record.
+
+    Parameters
+    ----------
+    p : ndarray
+        Parameter vector.
+    ax, ay : ndarray
+        Horizontal and vertical ground acceleration at the samples [m/s^2] (``ay`` ignored
+        unless ``has_ay``).
+    sh, sv : float
+        Scale factors applied to ``ax`` and ``ay``.
+    dt : float
+        Sample interval [s].
+    rtol, atol : float
+        Error tolerances of the rocking integration.
+    zeno_omega : float
+        Rocking stops when an impact leaves less than this angular velocity [rad/s].
+    store : bool
+        Fill ``hist`` (n x N_STATE) and ``modes`` (n) at the samples.
+    hist, modes : ndarray
+        History outputs (ignored unless ``store``).
+    summary : ndarray, shape (N_SUMMARY,)
+        Receives the summary of the run.
+    y_init : ndarray, shape (6,)
+        Initial ``(x_b, theta, x_s, v_b, theta_dot, v_s)``.
+
+    Returns
+    -------
+    ev_time, ev_kind, ev_from, ev_to : ndarray
+        The event log (only filled when ``store``).
+    """
+    n = ax.shape[0]
+    y = np.zeros(N_STATE)
+    y1 = np.zeros(N_STATE)
+    yr = np.zeros(N_STATE)
+    ytmp = np.zeros(N_STATE)
+    stages = np.zeros((7, N_STATE))
+    w7 = np.zeros(N_SOLVE_OUT)
+    w7b = np.zeros(N_SOLVE_OUT)
+    K = np.zeros((3, 3))
+    g0 = np.zeros(N_EVENTS)
+    g1 = np.zeros(N_EVENTS)
+    gw = np.zeros(N_EVENTS)
+    armed = np.ones(N_EVENTS, dtype=np.bool_)
+    ms = np.zeros(6, dtype=np.int64)
+    ev_t = np.empty(16)
+    ev_k = np.empty(16, dtype=np.int64)
+    ev_f = np.empty(16, dtype=np.int64)
+    ev_to = np.empty(16, dtype=np.int64)
+    n_ev = 0
+    for i in range(N_SUMMARY):
+        summary[i] = 0.0
+    impact_loss = 0.0
+    failure = 0
+    failure_time = np.nan
+    n_impacts = 0
+    n_fallback = 0
+    uplift = 0
+    peak_xb = 0.0
+    peak_th = 0.0
+    peak_th_time = 0.0
+    peak_xs = 0.0
+
+    for i in range(N_DYN):
+        y[i] = y_init[i]
+    k = 0
+    tau = 0.0
+    status = select_mode(p, y, ms, 0, 0.0, dt, ax, ay, has_ay, sh, sv, -1, w7)
+    if status == 2:
+        failure = Failure.SEPARATION
+        failure_time = 0.0
+    elif status == 1:
+        n_fallback += 1
+    if store:
+        ev_t[0] = 0.0
+        ev_k[0] = EventKind.SEPARATION if failure else EventKind.START
+        ev_f[0] = 0
+        ev_to[0] = 0 if failure else mode_number(ms)
+    n_ev = 1
+    if ms[MS_ROCK]:
+        uplift = 1
+    event_values(p, ms, y, 0, 0.0, dt, ax, ay, has_ay, sh, sv, g0, w7)
+    if store:
+        for i in range(N_STATE):
+            hist[0, i] = y[i]
+        modes[0] = 0 if failure else mode_number(ms)
+    h_rock = dt
+    events_here = 0
+    while k < n - 1 and failure == 0:
+        remaining = dt - tau
+        rocking = ms[MS_ROCK] == 1
+        h = min(h_rock, remaining) if rocking else remaining
+        err = advance(p, ms, y, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
+        if err < 0.0:
+            failure = Failure.SOLVER_ERROR
+            failure_time = k * dt + tau
+            break
+        if rocking:
+            err = error_norm(y, y1, stages, h, rtol, atol)
+            if err > 1.0:
+                h_rock = h * max(MIN_FACTOR, SAFETY * err ** (-1.0 / (DP_ERROR_ORDER + 1)))
+                if h_rock < MIN_STEP:
+                    failure = Failure.SOLVER_ERROR
+                    failure_time = k * dt + tau
+                    break
+                continue
+        # slopes at the start (from the first stage) for velocity-type events
+        d_start_b = stages[0, Y_VB]
+        d_start_s = stages[0, Y_VS]
+        ok = event_values(p, ms, y1, k, tau + h, dt, ax, ay, has_ay, sh, sv, g1, w7b)
+        if not ok:
+            failure = Failure.SOLVER_ERROR
+            failure_time = k * dt + tau
+            break
+        best_h = h + 1.0
+        best_e = -1
+        for ie in range(N_EVENTS):
+            e = EVENT_PRIORITY[ie]
+            if not armed[e]:
+                continue
+            lo = 0.0
+            g_lo = g0[e]
+            hi = h
+            g_hi = g1[e]
+            fired = False
+            if g1[e] < 0.0:
+                fired = True
+                if g0[e] <= 0.0:
+                    # started on the boundary: look for the interior maximum first
+                    g_lo = 0.0
+                    if has_slope(e):
+                        if e == EV_G_SLIP:
+                            d0 = ms[MS_SIG1] * d_start_b
+                        elif e == EV_S_SLIP:
+                            d0 = ms[MS_SIG2] * d_start_s
+                        else:
+                            d0 = ms[MS_S] * y[Y_OM]
+                        d1 = event_slope(e, ms, y1, w7b)
+                        u, _ = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
+                        if u > 0.0:
+                            gm = event_after(e, p, ms, y, k, tau, u * h, dt, ax, ay, has_ay,
+                                             sh, sv, yr, stages, ytmp, w7, gw)
+                            if gm > 0.0:
+                                lo = u * h
+                                g_lo = gm
+            elif has_slope(e) and g0[e] > 0.0:
+                if e == EV_G_SLIP:
+                    d0 = ms[MS_SIG1] * d_start_b
+                elif e == EV_S_SLIP:
+                    d0 = ms[MS_SIG2] * d_start_s
+                else:
+                    d0 = ms[MS_S] * y[Y_OM]
+                d1 = event_slope(e, ms, y1, w7b)
+                if d0 < 0.0 and d1 > 0.0:
+                    u, vmin = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
+                    if u > 0.0 and vmin < 0.0:
+                        gm = event_after(e, p, ms, y, k, tau, u * h, dt, ax, ay, has_ay,
+                                         sh, sv, yr, stages, ytmp, w7, gw)
+                        if gm < 0.0:
+                            fired = True
+                            hi = u * h
+                            g_hi = gm
+            if fired:
+                if g_lo > 0.0:
+                    root = locate_root(e, lo, g_lo, hi, g_hi, p, ms, y, k, tau, dt, ax, ay,
+                                       has_ay, sh, sv, yr, stages, ytmp, w7, gw)
+                else:
+                    root = lo
+                # a later-priority event wins only if it is clearly earlier
+                if root < best_h - 2.0 * ROOT_TIME_TOL:
+                    best_h = root
+                    best_e = e
+        if best_e < 0:
+            # accept the whole step
+            if rocking and y[Y_OM] * y1[Y_OM] < 0.0:
+                ext = rotation_extremum(p, ms, y, k, tau, h, dt, ax, ay, has_ay, sh, sv, yr,
+                                        stages, ytmp, w7)
+                if ext > peak_th:
+                    peak_th = ext
+                    peak_th_time = k * dt + tau
+            for i in range(N_STATE):
+                y[i] = y1[i]
+            for e in range(N_EVENTS):
+                g0[e] = g1[e]
+                if not armed[e] and g1[e] > REARM_TOL:
+                    armed[e] = True
+            summary[S_MODE_TIME + mode_number(ms) - 1] += h
+            tau += h
+            if rocking and h < remaining:
+                h_rock = h * min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * max(err, 1e-10) ** (-1.0 / (DP_ERROR_ORDER + 1))))
+            elif rocking:
+                h_rock = max(h_rock, h)
+        else:
+            # advance to the event
+            advance(p, ms, y, k, tau, best_h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
+            for i in range(N_STATE):
+                y[i] = y1[i]
+            summary[S_MODE_TIME + mode_number(ms) - 1] += best_h
+            tau += best_h
+            t_now = k * dt + tau
+            from_mode = mode_number(ms)
+            trigger = -1
+            kind = EventKind.START
+            if best_e == EV_G_SLIP:
+                y[Y_VB] = 0.0
+                trigger = 0
+                kind = EventKind.GROUND_SLIP_STOP
+            elif best_e == EV_S_SLIP:
+                y[Y_VS] = 0.0
+                trigger = 2
+                kind = EventKind.SHIP_SLIP_STOP
+            elif best_e == EV_G_STICK:
+                trigger = 0
+                kind = EventKind.GROUND_SLIP_START
+            elif best_e == EV_S_STICK:
+                trigger = 2
+                kind = EventKind.SHIP_SLIP_START
+            elif best_e == EV_UPLIFT:
+                trigger = 1
+                kind = EventKind.UPLIFT
+                uplift = 1
+            elif best_e == EV_IMPACT:
+                y[Y_TH] = 0.0
+                loss, stopped = apply_impact(p, ms[MS_SLIP1], ms[MS_SLIP2], y, zeno_omega, K)
+                impact_loss += loss
+                y[Y_IMP] += loss
+                n_impacts += 1
+                trigger = 1
+                kind = EventKind.ROCKING_STOP if stopped else EventKind.IMPACT
+            elif best_e == EV_OVERTURN:
+                failure = Failure.OVERTURNING
+                kind = EventKind.OVERTURNING
+            else:
+                failure = Failure.SEPARATION
+                kind = EventKind.SEPARATION
+            if failure == 0:
+                old0, old1, old2, old3, old4, old5 = ms[0], ms[1], ms[2], ms[3], ms[4], ms[5]
+                status = select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7)
+                if status == 2:
+                    failure = Failure.SEPARATION
+                    kind = EventKind.SEPARATION
+                else:
+                    if status == 1:
+                        n_fallback += 1
+                    same = (old0 == ms[0] and old1 == ms[1] and old2 == ms[2]
+                            and old3 == ms[3] and old4 == ms[4] and old5 == ms[5])
+                    if same and best_e != EV_IMPACT:
+                        # grazing contact: the constraint touched zero and holds again
+                        armed[best_e] = False
+                    else:
+                        for e in range(N_EVENTS):
+                            armed[e] = True
+                    if ms[MS_ROCK]:
+                        uplift = 1
+            if failure != 0:
+                failure_time = t_now
+            if store:
+                ev_t, ev_k, ev_f, ev_to = _grow(ev_t, ev_k, ev_f, ev_to, n_ev)
+                ev_t[n_ev] = t_now
+                ev_k[n_ev] = kind
+                ev_f[n_ev] = from_mode
+                ev_to[n_ev] = 0 if failure else mode_number(ms)
+            n_ev += 1
+            events_here += 1
+            if events_here > MAX_EVENTS_PER_SAMPLE and failure == 0:
+                failure = Failure.SOLVER_ERROR
+                failure_time = t_now
+            if failure == 0:
+                event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g0, w7)
+        # peaks
+        axb = abs(y[Y_XB])
+        if axb > peak_xb:
+            peak_xb = axb
+        ath = abs(y[Y_TH])
+        if ath > peak_th:
+            peak_th = ath
+            peak_th_time = k * dt + tau
+        axs = abs(y[Y_XS])
+        if axs > peak_xs:
+            peak_xs = axs
+        if failure == 0 and dt - tau <= 1e-12 * dt:
+            k += 1
+            tau = 0.0
+            events_here = 0
+            if store:
+                for i in range(N_STATE):
+                    hist[k, i] = y[i]
+                modes[k] = mode_number(ms)
+    end_time = k * dt + tau
+    if failure != 0 and store:
+        for j in range(k + 1, n):
+            for i in range(N_STATE):
+                hist[j, i] = np.nan
+            modes[j] = 0
+    summary[S_PEAK_XB] = peak_xb
+    summary[S_PEAK_TH] = peak_th
+    summary[S_PEAK_TH_TIME] = peak_th_time
+    summary[S_PEAK_XS] = peak_xs
+    summary[S_RES_XB] = y[Y_XB]
+    summary[S_RES_XS] = y[Y_XS]
+    summary[S_UPLIFT] = uplift
+    summary[S_N_IMPACTS] = n_impacts
+    summary[S_FAILURE] = failure
+    summary[S_FAILURE_TIME] = failure_time
+    summary[S_END_TIME] = end_time
+    summary[S_N_EVENTS] = n_ev
+    summary[S_W_IN] = y[Y_WIN]
+    summary[S_DISSIPATED] = y[Y_DIS]
+    summary[S_IMPACT_LOSS] = impact_loss
+    summary[S_N_FALLBACK] = n_fallback
+    s_final = float(ms[MS_S]) if ms[MS_ROCK] else 1.0
+    summary[S_ENERGY_FINAL] = kinetic_energy(
+        p, y[Y_TH], s_final, ms[MS_ROCK], y[Y_VB], y[Y_OM], y[Y_VS]
+    ) + potential_energy(p, y[Y_TH])
+    return ev_t[:n_ev] if store else ev_t[:0], ev_k[:n_ev] if store else ev_k[:0], \
+        ev_f[:n_ev] if store else ev_f[:0], ev_to[:n_ev] if store else ev_to[:0]
+
+
+@njit(cache=True, parallel=True)
+def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
+             case_sv, rtol, atol, zeno_omega, summaries):
+    """Run many cases in parallel; each case is (record, parameter row, H scale, V scale).
+
+    Records are concatenated in ``acc_h``/``acc_v``; record ``r`` occupies
+    ``offsets[r]:offsets[r+1]``. Only summaries are produced.
+    """
+    n_cases = case_record.shape[0]
+    empty_hist = np.zeros((0, N_STATE))
+    empty_modes = np.zeros(0, dtype=np.int64)
+    at_rest = np.zeros(N_DYN)
+    for c in prange(n_cases):
+        r = case_record[c]
+        a0 = offsets[r]
+        a1 = offsets[r + 1]
+        run(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
+            case_sv[c], dts[r], rtol, atol, zeno_omega, False, empty_hist, empty_modes,
+            summaries[c], at_rest)
