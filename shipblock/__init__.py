@@ -25,9 +25,13 @@ from shipblock.system import ShipBlockSystem, system_restitution
 _LAZY = {
     "read_motion": "shipblock.motion",
     "GroundMotion": "shipblock.motion",
+    "COMPONENT_KEY": "shipblock.motion",
+    "rotate_to_azimuth": "shipblock.motion",
+    "read_record": "shipblock.io",
     "load_catalogue": "shipblock.catalogue",
     "ShipblockError": "shipblock.errors",
     "RecordError": "shipblock.errors",
+    "UnitsError": "shipblock.errors",
     "intensity": "shipblock.intensity",
     "processing": "shipblock.processing",
     "scaling": "shipblock.scaling",

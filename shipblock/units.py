@@ -12,6 +12,9 @@ import numpy as np
 #: Standard acceleration of gravity [m/s^2] (CGPM 1901, ISO 80000-3).
 STANDARD_GRAVITY = 9.80665
 
+#: One inch [m] (international inch, 1959).
+INCH = 0.0254
+
 #: Factors that convert an acceleration in the named unit to m/s^2.
 ACCELERATION_UNITS_TO_SI: dict[str, float] = {
     "m/s^2": 1.0,
@@ -23,6 +26,8 @@ ACCELERATION_UNITS_TO_SI: dict[str, float] = {
     "gal": 0.01,
     "mm/s^2": 0.001,
     "mm/s**2": 0.001,
+    "in/s^2": INCH,
+    "in/s**2": INCH,
     "g": STANDARD_GRAVITY,
 }
 

@@ -1,0 +1,194 @@
+"""The catalogue of shipped ground-motion records (``records/catalogue.toml``).
+
+Each ``[[record]]`` table of the catalogue names one station's record: its files, StationXML
+inventory, event (QuakeML), station and site, licence and credit, and the mapping of its channel
+codes to the components H1, H2 and V. Paths are relative to the catalogue file.
+:func:`load_catalogue` parses and validates the file (without reading any waveform); each
+:class:`CatalogueEntry` reads its :class:`~shipblock.motion.GroundMotion` on demand.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from shipblock.errors import RecordError
+from shipblock.motion import COMPONENTS, GroundMotion, read_motion
+
+__all__ = ["CatalogueEntry", "default_catalogue_path", "load_catalogue"]
+
+#: Catalogue layout version this module reads.
+SCHEMA_VERSION = 1
+
+_REQUIRED = ("id", "files", "station", "license", "credit")
+
+
+def default_catalogue_path() -> Path:
+    """Return the path of the repository's catalogue, ``records/catalogue.toml``.
+
+    Returns
+    -------
+    pathlib.Path
+        ``<repository>/records/catalogue.toml`` (the records are not part of the wheel).
+    """
+    return Path(__file__).resolve().parent.parent / "records" / "catalogue.toml"
+
+
+@dataclass(frozen=True)
+class CatalogueEntry:
+    """One shipped record (one station of one earthquake).
+
+    Attributes
+    ----------
+    id : str
+        Unique name, e.g. ``"south-napa-2014/NP.1765"``.
+    files : tuple of pathlib.Path
+        Waveform files (absolute).
+    inventory : pathlib.Path or None
+        StationXML with the instrument response, for raw counts.
+    event : pathlib.Path or None
+        QuakeML of the earthquake.
+    network, station : str
+        SEED network and station codes.
+    site : str
+        Site description.
+    license, credit : str
+        Terms of use and the credit line to give.
+    components : dict
+        Channel code (or file name) -> ``"H1"``, ``"H2"`` or ``"V"``.
+    units : str or None
+        Unit to state for files that carry none (``None`` when the files or the inventory tell).
+    extra : dict
+        Every other key of the table (event name, coordinates, source, ...).
+    """
+
+    id: str
+    files: tuple[Path, ...]
+    inventory: Path | None
+    event: Path | None
+    network: str
+    station: str
+    site: str
+    license: str
+    credit: str
+    components: dict = field(default_factory=dict)
+    units: str | None = None
+    extra: dict = field(default_factory=dict)
+
+    def read(self, azimuth: float | None = None, horizontal: str | None = None,
+             **kwargs) -> GroundMotion:
+        """Read the record into a ground motion in m/s^2.
+
+        Parameters
+        ----------
+        azimuth : float, optional
+            Dock transverse axis [deg clockwise from north]; see :func:`shipblock.read_motion`.
+        horizontal : {"H1", "H2"}, optional
+            Use one horizontal as-is.
+        **kwargs
+            Passed to :func:`shipblock.read_motion` (e.g. ``response="full"``).
+
+        Returns
+        -------
+        GroundMotion
+            The motion, with the catalogue entry's licence and credit in ``metadata["catalogue"]``.
+        """
+        gm = read_motion(
+            [str(p) for p in self.files],
+            inventory=None if self.inventory is None else str(self.inventory),
+            units=self.units,
+            azimuth=azimuth,
+            horizontal=horizontal,
+            channel_map=self.components or None,
+            event=None if self.event is None else str(self.event),
+            **kwargs,
+        )
+        gm.metadata["catalogue"] = {
+            "id": self.id, "site": self.site, "license": self.license, "credit": self.credit,
+        }
+        return gm
+
+
+def _path(base: Path, value, catalogue: Path, entry_id: str, key: str) -> Path:
+    if not isinstance(value, str) or not value:
+        raise RecordError(catalogue, f"record {entry_id!r}: {key} must be a non-empty path")
+    path = (base / value).resolve()
+    if not path.is_file():
+        raise RecordError(catalogue, f"record {entry_id!r}: {key} {value!r} does not exist")
+    return path
+
+
+def _entry(table: dict, base: Path, catalogue: Path) -> CatalogueEntry:
+    entry_id = table.get("id", "?")
+    missing = [k for k in _REQUIRED if k not in table]
+    if missing:
+        raise RecordError(catalogue, f"record {entry_id!r} lacks {', '.join(missing)}")
+    files = table["files"]
+    if isinstance(files, str):
+        files = [files]
+    if not files:
+        raise RecordError(catalogue, f"record {entry_id!r} lists no files")
+    components = dict(table.get("components", {}))
+    bad = {k: v for k, v in components.items() if v not in COMPONENTS}
+    if bad:
+        raise RecordError(catalogue, f"record {entry_id!r}: components must map to {COMPONENTS}:"
+                                     f" {bad}")
+    known = {"id", "files", "inventory", "event", "network", "station", "site", "license",
+             "credit", "components", "units"}
+    return CatalogueEntry(
+        id=str(entry_id),
+        files=tuple(_path(base, f, catalogue, entry_id, "file") for f in files),
+        inventory=(_path(base, table["inventory"], catalogue, entry_id, "inventory")
+                   if table.get("inventory") else None),
+        event=(_path(base, table["event"], catalogue, entry_id, "event")
+               if table.get("event") else None),
+        network=str(table.get("network", "")),
+        station=str(table["station"]),
+        site=str(table.get("site", "")),
+        license=str(table["license"]),
+        credit=str(table["credit"]),
+        components=components,
+        units=table.get("units"),
+        extra={k: v for k, v in table.items() if k not in known},
+    )
+
+
+def load_catalogue(path=None) -> dict[str, CatalogueEntry]:
+    """Load a record catalogue.
+
+    Parameters
+    ----------
+    path : str or os.PathLike, optional
+        A catalogue TOML file; default :func:`default_catalogue_path`.
+
+    Returns
+    -------
+    dict
+        Entry id -> :class:`CatalogueEntry`, in file order.
+
+    Raises
+    ------
+    RecordError
+        If the file is missing or malformed, an entry lacks a required key, an id repeats, or a
+        listed file does not exist.
+    """
+    catalogue = Path(path) if path is not None else default_catalogue_path()
+    try:
+        with open(catalogue, "rb") as fh:
+            document = tomllib.load(fh)
+    except FileNotFoundError:
+        raise RecordError(catalogue, "catalogue file not found") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise RecordError(catalogue, f"is not valid TOML: {exc}") from exc
+    version = document.get("schema_version", SCHEMA_VERSION)
+    if version != SCHEMA_VERSION:
+        raise RecordError(catalogue, f"schema_version {version} is not {SCHEMA_VERSION}")
+    base = catalogue.resolve().parent
+    entries: dict[str, CatalogueEntry] = {}
+    for table in document.get("record", []):
+        entry = _entry(table, base, catalogue)
+        if entry.id in entries:
+            raise RecordError(catalogue, f"record id {entry.id!r} appears twice")
+        entries[entry.id] = entry
+    return entries

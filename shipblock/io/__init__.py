@@ -1,0 +1,120 @@
+"""Reading ground-motion records into obspy Streams.
+
+Formats obspy already reads (MiniSEED, SAC, K-NET, Kinemetrics EVT, ...) go straight to
+:func:`obspy.read`. Formats obspy lacks are obspy waveform plug-ins registered through entry points
+by shipblock's ``pyproject.toml`` (so ``obspy.read("x.AT2")`` works once shipblock is installed):
+
+================  =================================  ==========================================
+format            module                             what
+================  =================================  ==========================================
+SHIPBLOCK_AT2     :mod:`shipblock.io.at2`            PEER NGA ``.AT2`` (g)
+SHIPBLOCK_COSMOS  :mod:`shipblock.io.cosmos`         COSMOS / CSMIP V1 and V2 (unit codes)
+SHIPBLOCK_ESM     :mod:`shipblock.io.esm`            ESM ASCII (``UNITS`` key)
+SHIPBLOCK_TEXT    :mod:`shipblock.io.text`           one/two-column text or CSV (stated units)
+================  =================================  ==========================================
+
+:func:`read_record` wraps :func:`obspy.read` so that every failure becomes a
+:class:`~shipblock.errors.RecordError` naming the file, and so that plain text files (which obspy
+cannot auto-detect, their units being unknown) are read with the caller's ``units``.
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+
+import obspy
+
+from shipblock.errors import RecordError, ShipblockError
+from shipblock.io import at2, cosmos, esm, text
+from shipblock.io._common import peek_text
+
+__all__ = ["FORMATS", "read_record"]
+
+#: The formats shipblock adds to obspy: name -> (detector, reader).
+FORMATS = {
+    at2.FORMAT: (at2.is_at2, at2.read_at2),
+    cosmos.FORMAT: (cosmos.is_cosmos, cosmos.read_cosmos),
+    esm.FORMAT: (esm.is_esm, esm.read_esm),
+    text.FORMAT: (text.is_text, text.read_text_record),
+}
+
+
+def _looks_like_plain_text(path) -> bool:
+    """Tell whether a file is text whose non-comment lines are mostly numbers."""
+    content = peek_text(path)
+    if content is None:
+        return False
+    lines = [ln for ln in content.splitlines()[:50] if ln.strip()]
+    numeric = 0
+    for line in lines:
+        tokens = line.replace(",", " ").replace(";", " ").split()
+        try:
+            [float(t) for t in tokens]
+        except ValueError:
+            continue
+        numeric += 1
+    return numeric >= max(1, len(lines) // 2)
+
+
+def read_record(path, format: str | None = None, units: str | None = None, **kwargs):
+    """Read one record file into an obspy Stream.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    format : str, optional
+        An obspy format name (``"MSEED"``, ``"SAC"``, ``"KNET"``, ``"SHIPBLOCK_AT2"``,
+        ``"SHIPBLOCK_TEXT"``, ...); auto-detected when omitted.
+    units : str, optional
+        Acceleration unit of a plain text file (passed to the ``SHIPBLOCK_TEXT`` reader only).
+    **kwargs
+        Passed to the reader (for example ``dt`` [s] for a one-column text file).
+
+    Returns
+    -------
+    obspy.Stream
+        The traces as the file holds them (each tagged with ``stats.source_file``). Traces of
+        shipblock's own formats are already in m/s^2 (``stats.units``); others are as stored
+        (counts, or whatever the file holds).
+
+    Raises
+    ------
+    RecordError
+        If the file does not exist, its format is unknown, or it is corrupt or truncated.
+    """
+    name = os.fspath(path)
+    if not os.path.isfile(name):
+        raise RecordError(name, "no such file")
+    if format is not None and format.upper() == text.FORMAT:
+        kwargs["units"] = units
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            stream = obspy.read(name, format=format, **kwargs)
+        except ShipblockError:
+            raise
+        except TypeError as exc:
+            if "Unknown format" not in str(exc) and "not supported" not in str(exc):
+                raise RecordError(name, f"cannot be read: {exc}") from exc
+            if format is None and _looks_like_plain_text(name):
+                stream = text.read_text_record(name, units=units, **kwargs)
+            else:
+                raise RecordError(
+                    name,
+                    f"unknown format ({exc}); known formats: obspy's and "
+                    + ", ".join(FORMATS),
+                ) from exc
+        except Exception as exc:  # noqa: BLE001 - obspy readers raise anything on corrupt files
+            raise RecordError(name, f"cannot be read (corrupt or truncated?): {exc}") from exc
+    for warning in caught:
+        message = str(warning.message)
+        if "end of file" in message.lower() or "truncated" in message.lower():
+            raise RecordError(name, f"is truncated or corrupt: {message}")
+        warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
+    if len(stream) == 0:
+        raise RecordError(name, "holds no traces")
+    for trace in stream:
+        trace.stats.source_file = name
+    return stream

@@ -1,0 +1,313 @@
+"""Helpers shared by the text-format readers (private).
+
+The readers accept what :func:`obspy.read` hands to a plug-in: a path (``str`` or
+:class:`pathlib.Path`) or an open binary/text file object. Detection (``is_*``) functions must never
+raise, so they go through :func:`peek_text`, which returns ``None`` for anything that is not a
+readable text file.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+
+import numpy as np
+from obspy import Trace
+
+from shipblock.errors import RecordError, UnitsError
+from shipblock.units import ACCELERATION_UNITS_TO_SI
+
+#: Number of bytes read by the format-detection functions [bytes].
+PEEK_BYTES = 8192
+
+#: Largest text record a reader accepts [bytes]; guards against feeding a huge binary file to a
+#: text parser (the largest real accelerogram text files are a few tens of MB).
+MAX_TEXT_BYTES = 512 * 1024 * 1024
+
+#: A floating-point number as written by Fortran or C (``1.0``, ``-.25E-03``, ``3``, ``1.2D+01``).
+FLOAT_RE = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?")
+
+#: Accepted spellings of acceleration units, mapped to the keys of
+#: :data:`shipblock.units.ACCELERATION_UNITS_TO_SI`.
+UNIT_ALIASES: dict[str, str] = {
+    "g": "g",
+    "g's": "g",
+    "gs": "g",
+    "g'": "g",
+    "gal": "gal",
+    "gals": "gal",
+    "cm/s^2": "cm/s^2",
+    "cm/s**2": "cm/s^2",
+    "cm/s/s": "cm/s^2",
+    "cm/s2": "cm/s^2",
+    "cm/sec^2": "cm/s^2",
+    "cm/sec2": "cm/s^2",
+    "cm/sec/sec": "cm/s^2",
+    "cm/sec**2": "cm/s^2",
+    "m/s^2": "m/s^2",
+    "m/s**2": "m/s^2",
+    "m/s/s": "m/s^2",
+    "m/s2": "m/s^2",
+    "m/sec^2": "m/s^2",
+    "m/sec2": "m/s^2",
+    "m/sec/sec": "m/s^2",
+    "mm/s^2": "mm/s^2",
+    "mm/s**2": "mm/s^2",
+    "mm/s/s": "mm/s^2",
+}
+
+
+def source_name(source) -> str:
+    """Return a printable name for a path or file object.
+
+    Parameters
+    ----------
+    source : str, os.PathLike or file-like
+        What a reader was given.
+
+    Returns
+    -------
+    str
+        The path, the file object's ``name`` attribute, or ``"<file object>"``.
+    """
+    if isinstance(source, (str, os.PathLike)):
+        return os.fspath(source)
+    name = getattr(source, "name", None)
+    return str(name) if isinstance(name, (str, os.PathLike)) else "<file object>"
+
+
+def _decode(raw: bytes) -> str | None:
+    """Decode bytes as text, or return ``None`` if they look binary."""
+    if b"\x00" in raw:
+        return None
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError:
+        pass
+    text = raw.decode("latin-1")
+    # Latin-1 decodes anything; insist on mostly printable characters.
+    printable = sum(ch.isprintable() or ch in "\r\n\t" for ch in text)
+    return text if printable >= 0.98 * max(len(text), 1) else None
+
+
+def _read_bytes(source, limit: int | None) -> bytes:
+    """Read up to ``limit`` bytes from a path or file object, restoring the file position."""
+    if isinstance(source, (str, os.PathLike)):
+        with open(source, "rb") as fh:
+            return fh.read(-1 if limit is None else limit)
+    position = source.tell() if hasattr(source, "tell") else None
+    try:
+        raw = source.read(-1 if limit is None else limit)
+    finally:
+        if position is not None and hasattr(source, "seek"):
+            source.seek(position)
+    if isinstance(raw, str):
+        raw = raw.encode("utf-8", errors="replace")
+    return raw
+
+
+def peek_text(source) -> str | None:
+    """Return the first :data:`PEEK_BYTES` of a file as text, or ``None`` (never raises).
+
+    Parameters
+    ----------
+    source : str, os.PathLike or file-like
+        A path or an open file.
+
+    Returns
+    -------
+    str or None
+        The beginning of the file as text; ``None`` if it cannot be read or looks binary.
+    """
+    try:
+        raw = _read_bytes(source, PEEK_BYTES)
+    except Exception:  # noqa: BLE001 - detection must never raise
+        return None
+    if not raw:
+        return None
+    # A multi-byte UTF-8 character may be cut at the end of the peek window.
+    for cut in range(4):
+        text = _decode(raw[: len(raw) - cut] if cut else raw)
+        if text is not None:
+            return text
+    return None
+
+
+def read_text(source) -> str:
+    """Read a whole text file.
+
+    Parameters
+    ----------
+    source : str, os.PathLike or file-like
+        A path or an open file.
+
+    Returns
+    -------
+    str
+        The file's text.
+
+    Raises
+    ------
+    RecordError
+        If the file cannot be opened, is too large, or is not text.
+    """
+    name = source_name(source)
+    try:
+        raw = _read_bytes(source, MAX_TEXT_BYTES + 1)
+    except OSError as exc:
+        raise RecordError(name, f"cannot be opened: {exc}") from exc
+    if len(raw) > MAX_TEXT_BYTES:
+        raise RecordError(name, f"is larger than {MAX_TEXT_BYTES} bytes; not a text record")
+    text = _decode(raw)
+    if text is None:
+        raise RecordError(name, "is not a text file (binary content)")
+    return text
+
+
+def parse_float(token: str) -> float:
+    """Parse one Fortran/C number, accepting the ``D`` exponent; raise ``ValueError`` if bad."""
+    return float(token.strip().replace("D", "E").replace("d", "e"))
+
+
+def parse_free_floats(lines, name: str, what: str) -> np.ndarray:
+    """Parse whitespace-separated numbers from lines of text.
+
+    Parameters
+    ----------
+    lines : iterable of str
+        Lines holding only numbers.
+    name : str
+        File name, for error messages.
+    what : str
+        What the numbers are (for error messages), e.g. ``"acceleration samples"``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The numbers, float64.
+
+    Raises
+    ------
+    RecordError
+        If a token is not a number.
+    """
+    values = []
+    for lineno, line in enumerate(lines, start=1):
+        for token in line.replace(",", " ").split():
+            try:
+                values.append(parse_float(token))
+            except ValueError:
+                raise RecordError(
+                    name, f"{what}: {token!r} is not a number (data line {lineno})"
+                ) from None
+    return np.asarray(values, dtype=np.float64)
+
+
+def canonical_unit(unit: str) -> str | None:
+    """Map a spelling of an acceleration unit to a key of the SI conversion table.
+
+    Parameters
+    ----------
+    unit : str
+        For example ``"g"``, ``"G's"``, ``"cm/sec2"``, ``"gal"``, ``"m/s^2"``.
+
+    Returns
+    -------
+    str or None
+        A key of :data:`shipblock.units.ACCELERATION_UNITS_TO_SI`, or ``None`` if unknown.
+    """
+    key = unit.strip().lower().replace(" ", "")
+    key = UNIT_ALIASES.get(key, key)
+    return key if key in ACCELERATION_UNITS_TO_SI else None
+
+
+def si_factor(unit: str, name: str) -> float:
+    """Return the factor that converts ``unit`` to m/s^2.
+
+    Parameters
+    ----------
+    unit : str
+        An acceleration unit (any spelling accepted by :func:`canonical_unit`).
+    name : str
+        File name, for the error message.
+
+    Returns
+    -------
+    float
+        Conversion factor [m/s^2 per unit].
+
+    Raises
+    ------
+    UnitsError
+        If the unit is not a known acceleration unit.
+    """
+    key = canonical_unit(unit)
+    if key is None:
+        known = ", ".join(sorted(set(UNIT_ALIASES.values())))
+        raise UnitsError(name, f"unknown acceleration unit {unit!r}; known units: {known}")
+    return ACCELERATION_UNITS_TO_SI[key]
+
+
+def check_samples(data: np.ndarray, name: str, what: str) -> None:
+    """Refuse empty records and non-finite samples.
+
+    Parameters
+    ----------
+    data : numpy.ndarray
+        Samples.
+    name : str
+        File name, for the error message.
+    what : str
+        Which record or channel (for the error message).
+
+    Raises
+    ------
+    RecordError
+        If there are no samples, or any sample is NaN or infinite.
+    """
+    if data.size == 0:
+        raise RecordError(name, f"{what} has no samples (zero-length record)")
+    bad = ~np.isfinite(data)
+    if bad.any():
+        first = int(np.flatnonzero(bad)[0])
+        raise RecordError(
+            name, f"{what} has {int(bad.sum())} NaN/inf samples (first at index {first})"
+        )
+
+
+def check_delta(delta: float, name: str) -> float:
+    """Validate a sampling interval [s] and return it as a float.
+
+    Raises
+    ------
+    RecordError
+        If the interval is not a finite positive number.
+    """
+    if not (isinstance(delta, (int, float)) and math.isfinite(delta) and delta > 0):
+        raise RecordError(name, f"sampling interval {delta!r} s is not a positive number")
+    return float(delta)
+
+
+def make_trace(data, delta: float, stats: dict) -> Trace:
+    """Build an obspy Trace of float64 samples.
+
+    Parameters
+    ----------
+    data : array_like
+        Samples (already in the unit given in ``stats["units"]``).
+    delta : float
+        Sampling interval [s].
+    stats : dict
+        Extra header entries (network, station, channel, units, format header, ...).
+
+    Returns
+    -------
+    obspy.Trace
+        The trace.
+    """
+    trace = Trace(data=np.ascontiguousarray(data, dtype=np.float64))
+    trace.stats.delta = delta
+    for key, value in stats.items():
+        trace.stats[key] = value
+    return trace

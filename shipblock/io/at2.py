@@ -1,0 +1,231 @@
+"""Reader for PEER NGA ``.AT2`` acceleration files (obspy waveform plug-in ``SHIPBLOCK_AT2``).
+
+Layout, from the PEER Strong Motion Database documentation [1]_ and the NGA-West2 files: four
+header lines, then the samples read horizontally line by line (usually 5 per line, ``E15.7``):
+
+1. title, e.g. ``PEER NGA STRONG MOTION DATABASE RECORD``;
+2. earthquake name, date, station and component, comma separated, e.g.
+   ``Helena Montana-01, 10/31/1935, Carroll College, 180``;
+3. quantity and units, e.g. ``ACCELERATION TIME SERIES IN UNITS OF G``;
+4. ``NPTS=  4000, DT=   .0100 SEC`` (NGA) or ``4000   0.0100   NPTS, DT`` (older PEER files).
+
+The samples are in g (the format's unit; the header says so). They are converted to m/s^2 with
+:data:`shipblock.units.STANDARD_GRAVITY`; ``stats.units`` is ``"m/s**2"`` and
+``stats.original_units`` is ``"g"``. The component token of line 2 gives the orientation: a number
+is the azimuth [deg clockwise from north]; ``UP``/``V``/``VER``/``Z`` is vertical positive up and
+``DWN``/``DOWN`` vertical positive down. The file holds no start time, so traces start at the
+epoch (1970-01-01T00:00:00Z).
+
+References
+----------
+.. [1] PEER Strong Motion Database, "Sample data files",
+   http://peer.berkeley.edu/smcat/data.html (accessed 2024).
+"""
+
+from __future__ import annotations
+
+import re
+
+from obspy import Stream
+from obspy.core import AttribDict
+
+from shipblock.errors import RecordError, UnitsError
+from shipblock.io._common import (
+    FLOAT_RE,
+    canonical_unit,
+    check_delta,
+    check_samples,
+    make_trace,
+    parse_float,
+    peek_text,
+    read_text,
+    si_factor,
+    source_name,
+)
+
+__all__ = ["FORMAT", "is_at2", "read_at2"]
+
+#: Name under which the reader is registered as an obspy waveform plug-in.
+FORMAT = "SHIPBLOCK_AT2"
+
+#: Titles that mark a PEER file (line 1), compared in upper case.
+_TITLES = ("PEER", "PACIFIC ENGINEERING", "PAIFIC ENGINEERING", "NGA")
+
+#: How many lines the NPTS/DT line may be from the top (7 for spectrally matched NRC files).
+_MAX_HEADER_LINES = 8
+
+_NPTS_DT_NGA = re.compile(
+    r"NPTS\s*=\s*(\d+)\s*[,;]?\s*DT\s*=\s*(" + FLOAT_RE.pattern + r")", re.IGNORECASE
+)
+_NPTS_DT_OLD = re.compile(
+    r"^\s*(\d+)\s+(" + FLOAT_RE.pattern + r")\s+NPTS\s*,\s*DT", re.IGNORECASE
+)
+_UNITS_RE = re.compile(r"UNITS\s+OF\s+([A-Z/*^0-9']+)|\(([A-Z/*^0-9' ]+)\)", re.IGNORECASE)
+_VERTICAL_UP = {"UP", "V", "VER", "VERT", "Z", "HNZ", "HLZ", "HHZ", "HGZ"}
+_VERTICAL_DOWN = {"DWN", "DOWN", "DN"}
+
+
+def _npts_dt(line: str):
+    """Return ``(npts, dt)`` from a header line, or ``None``."""
+    match = _NPTS_DT_NGA.search(line) or _NPTS_DT_OLD.search(line)
+    if match is None:
+        return None
+    return int(match.group(1)), parse_float(match.group(2))
+
+
+def _find_header(lines):
+    """Return the index of the NPTS/DT line and its values, or ``None``."""
+    if not lines or not any(t in lines[0].upper() for t in _TITLES):
+        return None
+    for index, line in enumerate(lines[1:_MAX_HEADER_LINES], start=1):
+        try:
+            found = _npts_dt(line)
+        except ValueError:
+            return None
+        if found is not None:
+            return index, found
+    return None
+
+
+def is_at2(filename) -> bool:
+    """Tell whether a file is a PEER AT2 acceleration file (never raises).
+
+    Parameters
+    ----------
+    filename : str, os.PathLike or file-like
+        The file to check.
+
+    Returns
+    -------
+    bool
+        ``True`` if line 1 is a PEER title and an ``NPTS``/``DT`` line follows within the header.
+    """
+    text = peek_text(filename)
+    if text is None:
+        return False
+    try:
+        return _find_header(text.splitlines()[:_MAX_HEADER_LINES]) is not None
+    except Exception:  # noqa: BLE001 - detection must never raise
+        return False
+
+
+def _orientation(component: str) -> dict:
+    """Map the component token of header line 2 to ``azimuth``/``dip`` [deg] entries."""
+    token = component.strip().upper()
+    if token in _VERTICAL_UP or token.endswith("-UP"):
+        return {"dip": -90.0}
+    if token in _VERTICAL_DOWN or token.endswith("-DWN"):
+        return {"dip": 90.0}
+    digits = re.search(r"(\d{1,3})$", token)
+    if digits is not None and 0 <= int(digits.group(1)) <= 360:
+        return {"azimuth": float(int(digits.group(1)) % 360), "dip": 0.0}
+    if len(token) == 3 and token[2] in "NE":
+        return {"azimuth": 0.0 if token[2] == "N" else 90.0, "dip": 0.0}
+    return {}
+
+
+def _units(line: str, name: str) -> tuple[str, bool]:
+    """Return the unit of the samples and whether the header stated it."""
+    upper = line.upper()
+    if "VELOCITY" in upper or "DISPLACEMENT" in upper:
+        raise UnitsError(name, f"holds {line.strip()!r}, not an acceleration time series")
+    for match in _UNITS_RE.finditer(line):
+        token = (match.group(1) or match.group(2) or "").strip()
+        for candidate in (token, token.rstrip("S").rstrip("'")):
+            key = canonical_unit(candidate)
+            if key is not None:
+                return key, True
+    # The AT2 format is defined in g; a header that does not repeat it still means g.
+    return "g", False
+
+
+def read_at2(filename, headonly: bool = False, **kwargs) -> Stream:
+    """Read a PEER AT2 acceleration file into a Stream of one trace in m/s^2.
+
+    Parameters
+    ----------
+    filename : str, os.PathLike or file-like
+        The AT2 file.
+    headonly : bool, optional
+        Read only the header; the trace then has no samples.
+    **kwargs
+        Ignored (obspy passes its own keywords to every plug-in).
+
+    Returns
+    -------
+    obspy.Stream
+        One trace; ``stats.units == "m/s**2"``, ``stats.original_units`` the header unit,
+        ``stats.azimuth``/``stats.dip`` [deg] where the component token tells them, and the
+        original header in ``stats.shipblock_at2``.
+
+    Raises
+    ------
+    RecordError
+        If the file is not a valid AT2 file, is truncated, or holds NaN/inf samples.
+    UnitsError
+        If the file holds velocity or displacement, or an unknown unit.
+    """
+    name = source_name(filename)
+    text = read_text(filename)
+    lines = text.splitlines()
+    try:
+        found = _find_header(lines[:_MAX_HEADER_LINES])
+    except ValueError:
+        found = None
+    if found is None:
+        raise RecordError(name, "is not a PEER AT2 file (no PEER title and NPTS/DT header line)")
+    npts_line, (npts, dt) = found
+    delta = check_delta(dt, name)
+    header_lines = lines[: npts_line + 1]
+    description = header_lines[1] if npts_line >= 2 else ""
+    units_line = header_lines[npts_line - 1] if npts_line >= 2 else ""
+    unit, stated = _units(units_line, name)
+    factor = si_factor(unit, name)
+
+    tokens = [t.strip() for t in description.split(",")]
+    component = tokens[-1] if len(tokens) >= 2 else ""
+    station = tokens[-2] if len(tokens) >= 3 else ""
+    header = AttribDict(
+        {
+            "header_lines": header_lines,
+            "event": tokens[0] if len(tokens) >= 2 else description.strip(),
+            "station_name": station,
+            "component": component,
+            "npts": npts,
+            "dt": dt,
+            "units": unit,
+            "units_stated_in_header": stated,
+        }
+    )
+    stats = {
+        "station": station,
+        "channel": component,
+        "units": "m/s**2",
+        "original_units": unit,
+        "shipblock_at2": header,
+        **_orientation(component),
+    }
+    if headonly:
+        trace = make_trace([], delta, stats)
+        trace.stats.npts = npts
+        return Stream([trace])
+
+    samples = []
+    for lineno, line in enumerate(lines[npts_line + 1 :], start=npts_line + 2):
+        values = FLOAT_RE.findall(line)
+        rest = FLOAT_RE.sub(" ", line).replace(",", " ").strip()
+        if rest:
+            raise RecordError(name, f"line {lineno}: {rest[:20]!r} is not a number (corrupt data)")
+        try:
+            samples.extend(parse_float(v) for v in values)
+        except ValueError:
+            raise RecordError(name, f"line {lineno}: unreadable number") from None
+    if len(samples) != npts:
+        what = "truncated" if len(samples) < npts else "longer than its header says"
+        raise RecordError(
+            name, f"is {what}: header NPTS={npts} but {len(samples)} samples were found"
+        )
+    trace = make_trace(samples, delta, stats)
+    check_samples(trace.data, name, "the acceleration record")
+    trace.data *= factor
+    return Stream([trace])
