@@ -220,6 +220,60 @@ class ShipBlockSystem:
         p[P_G] = self.g
         return p
 
+    @classmethod
+    def example(cls) -> ShipBlockSystem:
+        """A typical dry-dock configuration, used by the command line when no system is given.
+
+        An 8,000 t ship on 200 concrete keel blocks with timber caps, each 0.7 m wide, 1.2 m tall
+        and 1.5 t; concrete on concrete at the dock floor (mu_s = 0.6, mu_k = 0.5) and steel on
+        timber at the hull (mu_s = 0.5, mu_k = 0.4). Illustrative values, not a design basis.
+        """
+        return cls(
+            ship_mass=8.0e6, block_mass=1500.0, n_blocks=200, half_width=0.35, half_height=0.6,
+            mu_s_ground=0.6, mu_k_ground=0.5, mu_s_ship=0.5, mu_k_ship=0.4,
+        )
+
+    @classmethod
+    def from_mapping(cls, values, source: str = "system") -> ShipBlockSystem:
+        """Build a system from a mapping (for example a TOML table), naming unknown keys.
+
+        Parameters
+        ----------
+        values : Mapping
+            Constructor arguments; a nested ``system`` table is accepted too.
+        source : str
+            Where the values came from, for error messages.
+
+        Raises
+        ------
+        ValueError
+            For an unknown or missing key, or an invalid value; the message names it.
+        """
+        if "system" in values and isinstance(values["system"], dict):
+            values = values["system"]
+        known = set(cls.__dataclass_fields__)
+        unknown = sorted(set(values) - known)
+        if unknown:
+            raise ValueError(f"{source}: unknown system parameter(s) {unknown}; known: {sorted(known)}")
+        try:
+            return cls(**values)
+        except TypeError as exc:
+            raise ValueError(f"{source}: {exc}") from None
+        except ValueError as exc:
+            raise ValueError(f"{source}: {exc}") from None
+
+    @classmethod
+    def from_toml(cls, path) -> ShipBlockSystem:
+        """Read a system from a TOML file with a ``[system]`` table (SI units)."""
+        import tomllib
+
+        with open(path, "rb") as fh:
+            try:
+                data = tomllib.load(fh)
+            except tomllib.TOMLDecodeError as exc:
+                raise ValueError(f"{path}: not valid TOML: {exc}") from None
+        return cls.from_mapping(data, source=str(path))
+
     def replace(self, **changes) -> ShipBlockSystem:
         """A copy with some parameters changed (validated again)."""
         values = self.to_dict()

@@ -1,0 +1,428 @@
+"""The ``shipblock`` command: simulate, process, info, run, plot, bench.
+
+The command only parses arguments, calls the library and prints; every computation lives in the
+library. User errors print one line ``shipblock: error: ...`` and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from pathlib import Path
+
+from shipblock.units import STANDARD_GRAVITY
+
+log = logging.getLogger("shipblock")
+
+SYSTEM_FLAGS = {
+    "ship_mass": ("--ship-mass", float, "ship mass M [kg]"),
+    "block_mass": ("--block-mass", float, "mass of one keel block m [kg]"),
+    "n_blocks": ("--n-blocks", int, "number of keel blocks n"),
+    "half_width": ("--half-width", float, "block half width B [m]"),
+    "half_height": ("--half-height", float, "block half height H [m]"),
+    "mu_s_ground": ("--mu-s-ground", float, "static friction blocks/ground"),
+    "mu_k_ground": ("--mu-k-ground", float, "kinetic friction blocks/ground"),
+    "mu_s_ship": ("--mu-s-ship", float, "static friction blocks/ship"),
+    "mu_k_ship": ("--mu-k-ship", float, "kinetic friction blocks/ship"),
+    "restitution": ("--restitution", float, "restitution theta_dot+/theta_dot- (default: system value)"),
+    "impact_rule": ("--impact-rule", str, "impact rule: momentum (default) or paper"),
+}
+
+
+class UserError(Exception):
+    """An error caused by the user's input: reported in one line, no traceback."""
+
+
+# --------------------------------------------------------------------------- record input
+def _add_record_arguments(p):
+    g = p.add_argument_group("record")
+    g.add_argument("files", nargs="*", help="record files (MiniSEED, SAC, AT2, COSMOS, ESM, text, ...)")
+    g.add_argument("--record", help="id of a catalogue record, e.g. NP.1765 or south-napa-2014/NP.1765")
+    g.add_argument("--catalogue", help="record catalogue TOML (default: the shipped one)")
+    g.add_argument("--inventory", help="StationXML for raw counts")
+    g.add_argument("--units", help="units of records that do not state them: m/s^2, cm/s^2, gal, g")
+    g.add_argument("--azimuth", type=float,
+                   help="dock transverse axis [deg clockwise from north]: horizontals rotated to it")
+    g.add_argument("--horizontal", choices=["H1", "H2"], help="use this horizontal component")
+    g.add_argument("--processing", default="default",
+                   help="'default' (the documented chain), 'demean', 'none', or a TOML file with "
+                        "[[processing]] steps")
+
+
+def _find_entry(record_id, catalogue):
+    from shipblock.catalogue import load_catalogue
+
+    entries = load_catalogue(catalogue)
+    if record_id in entries:
+        return entries[record_id]
+    matches = [k for k in entries if k.endswith("/" + record_id) or k.split("/")[-1] == record_id]
+    if len(matches) == 1:
+        return entries[matches[0]]
+    known = ", ".join(sorted(entries))
+    raise UserError(f"record {record_id!r} is not in the catalogue; known records: {known}")
+
+
+def _processing_chain(spec):
+    from shipblock.processing import default_chain
+
+    if spec in (None, "default"):
+        return default_chain()
+    if spec == "none":
+        return []
+    if spec == "demean":
+        return [{"step": "demean"}]
+    import tomllib
+
+    path = Path(spec)
+    if not path.exists():
+        raise UserError(f"processing chain file {spec} does not exist")
+    with open(path, "rb") as fh:
+        data = tomllib.load(fh)
+    chain = data.get("processing")
+    if isinstance(chain, dict):
+        chain = chain.get("chain", chain.get("steps"))
+    if not isinstance(chain, list):
+        raise UserError(f"{spec}: expected a list of [[processing]] tables")
+    return chain
+
+
+def _load_motion(args):
+    from shipblock.motion import read_motion
+    from shipblock.processing import process_motion
+
+    if args.record and args.files:
+        raise UserError("give either --record or record files, not both")
+    if args.record:
+        entry = _find_entry(args.record, args.catalogue)
+        motion = entry.read(azimuth=args.azimuth, horizontal=args.horizontal)
+    elif args.files:
+        for f in args.files:
+            if not Path(f).exists():
+                raise UserError(f"{f}: no such file")
+        motion = read_motion(args.files if len(args.files) > 1 else args.files[0],
+                             inventory=args.inventory, units=args.units, azimuth=args.azimuth,
+                             horizontal=args.horizontal)
+    else:
+        raise UserError("no record: give record files or --record ID (see 'shipblock info --help')")
+    chain = _processing_chain(args.processing)
+    if chain:
+        motion = process_motion(motion, chain)
+    return motion
+
+
+def _motion_name(motion) -> str:
+    """Catalogue id, or NET.STA, of a GroundMotion."""
+    md = motion.metadata
+    cat = md.get("catalogue") or {}
+    if cat.get("id"):
+        return str(cat["id"])
+    st = md.get("station")
+    if isinstance(st, dict):
+        return f"{st.get('network', '')}.{st.get('station', '')}"
+    return str(st or md.get("name") or "record")
+
+
+# --------------------------------------------------------------------------- subcommands
+def _system_from_args(args):
+    from shipblock.system import ShipBlockSystem
+
+    system = ShipBlockSystem.from_toml(args.system) if args.system else ShipBlockSystem.example()
+    changes = {k: getattr(args, k) for k in SYSTEM_FLAGS if getattr(args, k) is not None}
+    return system.replace(**changes) if changes else system
+
+
+def cmd_simulate(args):
+    import numpy as np
+
+    from shipblock.solver import simulate
+
+    system = _system_from_args(args)
+    motion = _load_motion(args)
+    ax = motion.horizontal * args.scale
+    ay = None
+    if motion.vertical is not None and not args.no_vertical:
+        ay = motion.vertical * (args.scale if args.vertical_scale is None else args.vertical_scale)
+    log.info("simulating %d samples at dt = %g s", ax.size, motion.dt)
+    res = simulate(system, ax, ay, motion.dt, rtol=args.rtol)
+    out = sys.stdout
+    name = _motion_name(motion)
+    s = res.summary
+    rows = [
+        ("record", f"{name} ({ax.size} samples, dt = {motion.dt:g} s, "
+                   f"PGA_H = {np.abs(ax).max() / STANDARD_GRAVITY:.3f} g)"),
+        ("system", f"M = {system.ship_mass:.4g} kg on {system.n_blocks} blocks of "
+                   f"{system.block_mass:.4g} kg, 2B x 2H = {2 * system.half_width:g} x "
+                   f"{2 * system.half_height:g} m, e = {system.effective_restitution:.3f}"),
+        ("failure", "none" if res.failure is None else f"{res.failure} at t = {res.failure_time:.4f} s"),
+        ("peak block slip |x_b|", f"{100 * s['peak_block_slip']:.3f} cm"),
+        ("peak ship slip |x_s|", f"{100 * s['peak_ship_slip']:.3f} cm"),
+        ("peak rotation |theta|", f"{1000 * s['peak_rotation']:.3f} mrad "
+                                  f"({100 * s['peak_rotation_ratio']:.1f} % of theta_c)"),
+        ("residual x_b / x_s", f"{100 * s['residual_block_slip']:.3f} / "
+                               f"{100 * s['residual_ship_slip']:.3f} cm"),
+        ("uplift / impacts", f"{'yes' if s['uplift'] else 'no'} / {s['n_impacts']}"),
+    ]
+    width = max(len(r[0]) for r in rows)
+    for key, val in rows:
+        out.write(f"{key:<{width}}  {val}\n")
+    out.write("time per mode:\n")
+    from shipblock.modes import MODE_DESCRIPTIONS
+
+    for m in range(1, 9):
+        tm = s[f"time_in_mode_{m}"]
+        if tm > 0:
+            out.write(f"  {m} {MODE_DESCRIPTIONS[m]:<36} {tm:9.3f} s\n")
+    counts = {}
+    for e in res.events[1:]:
+        counts[e.kind] = counts.get(e.kind, 0) + 1
+    out.write("events: " + (", ".join(f"{k} {v}" for k, v in sorted(counts.items())) or "none") + "\n")
+    shown = [e for e in res.events[1:] if e.kind != "impact"][: args.events]
+    for e in shown:
+        out.write(f"  t = {e.time:10.5f} s  {e.kind:<18} mode {e.from_mode} -> {e.to_mode}\n")
+    if args.output:
+        path = Path(args.output)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        ds = res.to_dataset()
+        ds.attrs["record"] = str(name)
+        ds.attrs["processing"] = "\n".join(motion.metadata.get("processing", []) or [])
+        tmp = path.with_name(path.name + ".part")
+        ds.to_netcdf(tmp, engine="netcdf4")
+        tmp.replace(path)
+        out.write(f"response written to {path}\n")
+    figure = args.figure
+    if figure is None and args.output:
+        figure = str(Path(args.output).with_suffix(".png"))
+    if figure:
+        _save_figure(lambda: _response_figure(res, name), figure)
+        out.write(f"figure written to {figure}\n")
+    return 0
+
+
+def _response_figure(res, name):
+    from shipblock.plot import plot_response
+
+    axes = plot_response(res)
+    axes[0].figure.suptitle(f"{name}: " + axes[0].figure._suptitle.get_text())
+    return axes[0].figure
+
+
+def _save_figure(make, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = make()
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def cmd_info(args):
+    import numpy as np
+
+    from shipblock import intensity
+
+    motion = _load_motion(args)
+    out = sys.stdout
+    md = motion.metadata
+    site = (md.get("catalogue") or {}).get("site", "")
+    out.write(f"record      {_motion_name(motion)} {site}\n")
+    for f in md.get("source_files", []):
+        out.write(f"file        {f}\n")
+    out.write(f"start       {motion.starttime}\n")
+    out.write(f"sampling    dt = {motion.dt:g} s ({1 / motion.dt:g} Hz), {motion.npts} samples, "
+              f"{motion.npts * motion.dt:.2f} s\n")
+    units = md.get("units")
+    if isinstance(units, dict):
+        for comp, note in units.items():
+            out.write(f"units {comp:<5} {note}\n")
+    elif units:
+        out.write(f"units       {units}\n")
+    out.write("component  azimuth   PGA [g]   PGV [cm/s]  Arias [m/s]  CAV [m/s]  D5-95 [s]\n")
+    for comp, acc in motion.components.items():
+        im = intensity.intensity_measures(acc, motion.dt, periods=(0.2, 1.0))
+        az = motion.azimuths.get(comp)
+        out.write(f"{comp:<10} {'' if az is None else f'{az:7.1f}':>7}  {im['pga'] / STANDARD_GRAVITY:8.4f}"
+                  f"  {100 * im['pgv']:10.3f}  {im['arias']:11.4f}  {im['cav']:9.4f}"
+                  f"  {im['d5_95']:9.2f}\n")
+    h = motion.horizontal
+    sa = intensity.spectral_acceleration(h, motion.dt, np.array([0.2, 1.0]), 0.05)
+    out.write(f"horizontal used by the solver: PGA {np.abs(h).max() / STANDARD_GRAVITY:.4f} g, "
+              f"Sa(0.2 s) {sa[0] / STANDARD_GRAVITY:.4f} g, Sa(1 s) {sa[1] / STANDARD_GRAVITY:.4f} g\n")
+    for note in md.get("processing", []) or []:
+        out.write(f"processing  {note}\n")
+    return 0
+
+
+def cmd_process(args):
+    import csv
+
+    from shipblock import intensity
+
+    motion = _load_motion(args)
+    outdir = Path(args.output_dir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    st = motion.stream.copy()
+    name = _motion_name(motion)
+    stem = name.replace("/", "_")
+    fmt = args.format.upper()
+    ext = {"MSEED": "mseed", "SAC": "sac"}[fmt]
+    written = []
+    if fmt == "SAC":
+        for tr in st:
+            path = outdir / f"{stem}.{tr.stats.channel}.{ext}"
+            tr.write(str(path), format="SAC")
+            written.append(path)
+    else:
+        for tr in st:
+            tr.data = tr.data.astype("float64")
+        path = outdir / f"{stem}.{ext}"
+        st.write(str(path), format="MSEED")
+        written.append(path)
+    table = outdir / f"{stem}_intensity.csv"
+    with open(table, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["component", "pga_m_s2", "t_pga_s", "pgv_m_s", "pgd_m", "arias_m_s", "cav_m_s",
+                    "cav5_m_s", "d5_75_s", "d5_95_s", "sa_0.2s_m_s2", "sa_1.0s_m_s2"])
+        for comp, acc in motion.components.items():
+            im = intensity.intensity_measures(acc, motion.dt, periods=(0.2, 1.0))
+            w.writerow([comp, im["pga"], im["t_pga"], im["pgv"], im["pgd"], im["arias"], im["cav"],
+                        im["cav5"], im["d5_75"], im["d5_95"], im["sa"][0], im["sa"][1]])
+    for p in written + [table]:
+        sys.stdout.write(f"written {p}\n")
+    return 0
+
+
+def cmd_run(args):
+    from shipblock.fragility.pipeline import run_pipeline
+
+    ds = run_pipeline(args.pipeline, output=args.output, scheduler=args.scheduler,
+                      progress=not args.quiet)
+    out = sys.stdout
+    out.write(f"results written to {ds.encoding.get('source', args.output or 'the pipeline output')}\n")
+    if "median" in ds:
+        out.write("fitted fragility (lognormal):\n")
+        for ls in ds["limit_state"].values:
+            med = ds["median"].sel(limit_state=ls)
+            beta = ds["beta"].sel(limit_state=ls)
+            if med.ndim == 0:
+                units = ds["median"].attrs.get("units", "")
+                out.write(f"  {str(ls):<24} median {float(med):.4g} {units}, beta {float(beta):.3f}\n")
+    if args.figure:
+        from shipblock.plot import plot_fragility
+
+        _save_figure(lambda: plot_fragility(ds).figure, args.figure)
+        out.write(f"figure written to {args.figure}\n")
+    return 0
+
+
+def cmd_plot(args):
+    import xarray as xr
+
+    with xr.open_dataset(args.results) as ds:
+        ds = ds.load()
+    figure = args.figure or str(Path(args.results).with_suffix(".png"))
+    if "x_b" in ds and "time" in ds.dims:
+        from shipblock.plot import plot_response
+
+        _save_figure(lambda: plot_response(ds)[0].figure, figure)
+    elif "median" in ds:
+        from shipblock.plot import plot_fragility
+
+        _save_figure(lambda: plot_fragility(ds).figure, figure)
+    else:
+        raise UserError(f"{args.results}: neither a simulation response nor a fragility result")
+    sys.stdout.write(f"figure written to {figure}\n")
+    return 0
+
+
+def cmd_bench(args):
+    from shipblock.bench import run_benchmarks
+
+    return run_benchmarks(quick=args.quick, pyslammer=not args.no_pyslammer, output=args.output)
+
+
+# --------------------------------------------------------------------------- parser
+def build_parser():
+    p = argparse.ArgumentParser(
+        prog="shipblock",
+        description="Seismic response of a ship standing free on keel blocks: simulation, "
+                    "ground-motion processing and fragility.",
+    )
+    p.add_argument("-v", "--verbose", action="count", default=0, help="more log output")
+    p.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+
+    s = sub.add_parser("simulate", help="simulate one record on one ship-block system",
+                       description="Simulate one record; prints a summary, writes NetCDF and a figure.")
+    _add_record_arguments(s)
+    g = s.add_argument_group("system (defaults: ShipBlockSystem.example())")
+    g.add_argument("--system", help="TOML file with a [system] table (SI units)")
+    for key, (flag, typ, help_) in SYSTEM_FLAGS.items():
+        g.add_argument(flag, dest=key, type=typ, help=help_)
+    g = s.add_argument_group("run")
+    g.add_argument("--scale", type=float, default=1.0, help="factor on the horizontal (and vertical)")
+    g.add_argument("--vertical-scale", type=float, help="independent factor on the vertical")
+    g.add_argument("--no-vertical", action="store_true", help="ignore the vertical component")
+    g.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of rocking phases")
+    g.add_argument("--output", "-o", help="NetCDF file for the response")
+    g.add_argument("--figure", help="PNG for the response figure (default: next to --output)")
+    g.add_argument("--events", type=int, default=20, help="list at most this many events")
+    s.set_defaults(func=cmd_simulate)
+
+    s = sub.add_parser("info", help="what is in a record: components, units, sampling, IMs")
+    _add_record_arguments(s)
+    s.set_defaults(func=cmd_info)
+
+    s = sub.add_parser("process", help="process records; write MiniSEED/SAC and an IM table")
+    _add_record_arguments(s)
+    s.add_argument("--output-dir", "-o", default="processed", help="output folder")
+    s.add_argument("--format", default="MSEED", choices=["MSEED", "SAC", "mseed", "sac"])
+    s.set_defaults(func=cmd_process)
+
+    s = sub.add_parser("run", help="run a pipeline file (batch, fragility)")
+    s.add_argument("pipeline", help="pipeline TOML, e.g. pipelines/demo.toml")
+    s.add_argument("--output", "-o", help="NetCDF output (overrides the pipeline's)")
+    s.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
+    s.add_argument("--figure", help="PNG of the fragility curves")
+    s.set_defaults(func=cmd_run)
+
+    s = sub.add_parser("plot", help="figure from a results NetCDF (response or fragility)")
+    s.add_argument("results", help="NetCDF written by 'simulate' or 'run'")
+    s.add_argument("--figure", "-o", help="PNG path (default: next to the results)")
+    s.set_defaults(func=cmd_plot)
+
+    s = sub.add_parser("bench", help="benchmarks: samples/s, pySLAMMER comparison, batch scaling")
+    s.add_argument("--quick", action="store_true", help="smaller, faster benchmark")
+    s.add_argument("--no-pyslammer", action="store_true", help="skip the pySLAMMER comparison")
+    s.add_argument("--output", "-o", help="also write the results as JSON")
+    s.set_defaults(func=cmd_bench)
+    return p
+
+
+def main(argv=None):
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    level = logging.WARNING if args.quiet else (logging.DEBUG if args.verbose > 1 else logging.INFO)
+    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+    if args.command is None:
+        parser.print_help()
+        return 2
+    from shipblock.errors import ShipblockError
+
+    try:
+        return args.func(args)
+    except (UserError, ShipblockError, ValueError, FileNotFoundError, OSError) as exc:
+        if args.verbose > 1:
+            raise
+        sys.stderr.write(f"shipblock: error: {exc}\n")
+        return 2
+    except KeyboardInterrupt:
+        sys.stderr.write("shipblock: interrupted\n")
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,275 @@
+"""Figures: response histories, records, spectra, IDA and fragility curves.
+
+Every function takes ``ax=None`` (or ``axes=None`` for multi-panel figures), draws into the given
+axes or a new figure, and returns what it drew. Nothing here calls ``plt.show()``. Accelerations
+are shown in g, displacements in cm and rotations in mrad: the units engineers read at a glance;
+the data stay SI.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from shipblock.modes import MODE_DESCRIPTIONS
+from shipblock.units import STANDARD_GRAVITY
+
+#: One colour per mode (1..8), light enough to sit behind the curves.
+MODE_COLOURS = {
+    1: "#ffffff",
+    2: "#cfe3f7",
+    3: "#f9d7b5",
+    4: "#d5ecd0",
+    5: "#b9d3ee",
+    6: "#f3c6c6",
+    7: "#e6d5f0",
+    8: "#f5e9a8",
+}
+EVENT_STYLES = {
+    "impact": dict(color="0.55", lw=0.5, ls="-"),
+    "uplift": dict(color="tab:orange", lw=0.8, ls="--"),
+    "rocking_stop": dict(color="tab:orange", lw=0.8, ls=":"),
+    "ground_slip_start": dict(color="tab:blue", lw=0.6, ls="--"),
+    "ground_slip_stop": dict(color="tab:blue", lw=0.6, ls=":"),
+    "ship_slip_start": dict(color="tab:green", lw=0.6, ls="--"),
+    "ship_slip_stop": dict(color="tab:green", lw=0.6, ls=":"),
+    "overturning": dict(color="red", lw=2.0, ls="-"),
+    "separation": dict(color="red", lw=2.0, ls="-"),
+    "solver_error": dict(color="red", lw=2.0, ls="-."),
+}
+
+
+def _pyplot():
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _new_axes(nrows, sharex=True, height=1.8):
+    plt = _pyplot()
+    fig, axes = plt.subplots(nrows, 1, sharex=sharex, figsize=(9.0, height * nrows + 0.8),
+                             constrained_layout=True)
+    return fig, np.atleast_1d(axes)
+
+
+def mode_spans(time, mode):
+    """Contiguous runs of one mode: list of (t_start, t_end, mode)."""
+    mode = np.asarray(mode)
+    if mode.size == 0:
+        return []
+    change = np.flatnonzero(np.diff(mode)) + 1
+    starts = np.concatenate([[0], change])
+    ends = np.concatenate([change, [mode.size - 1]])
+    return [(time[s], time[e], int(mode[s])) for s, e in zip(starts, ends, strict=True)]
+
+
+class _DatasetResponse:
+    """Read-only view of a response Dataset (from ``SimulationResult.to_dataset``) for plotting."""
+
+    def __init__(self, ds):
+        import math
+
+        from shipblock.result import Event
+
+        self.time = ds["time"].values
+        self.x_b = ds["x_b"].values
+        self.theta = ds["theta"].values
+        self.x_s = ds["x_s"].values
+        self.mode = ds["mode"].values.astype(int)
+        self.ground_acceleration = (ds["ground_acceleration_h"].values,
+                                    ds["ground_acceleration_v"].values)
+        self.events = [
+            Event(float(t), str(k), int(f), int(to))
+            for t, k, f, to in zip(ds["event_time"].values, ds["event_kind"].values,
+                                   ds["event_from_mode"].values, ds["event_to_mode"].values,
+                                   strict=True)
+        ]
+        failure = ds.attrs.get("failure", "none")
+        self.failure = None if failure == "none" else failure
+        self.failure_time = float(ds.attrs.get("failure_time_s", float("nan")))
+
+        class _System:
+            critical_angle = math.atan2(float(ds.attrs["system_half_width"]),
+                                        float(ds.attrs["system_half_height"]))
+
+        self.system = _System()
+
+
+def active_window(time, acc, events=(), margin=2.0):
+    """Time window holding 1-99 % of the Arias intensity and all events, plus a margin [s]."""
+    energy = np.cumsum(np.asarray(acc, float) ** 2)
+    if energy[-1] <= 0:
+        return time[0], time[-1]
+    frac = energy / energy[-1]
+    t0 = time[np.searchsorted(frac, 0.01)]
+    t1 = time[min(np.searchsorted(frac, 0.99), time.size - 1)]
+    ev = [e.time for e in events if e.kind != "start"]
+    if ev:
+        t0, t1 = min(t0, min(ev)), max(t1, max(ev))
+    return max(time[0], t0 - margin), min(time[-1], t1 + 1.5 * margin)
+
+
+def plot_response(result, axes=None, max_event_lines=400, window="auto"):
+    """Response history: ground acceleration, block slip, rotation, ship slip, modes, events.
+
+    Parameters
+    ----------
+    result : SimulationResult or xarray.Dataset
+        The simulation to draw (or its :meth:`~SimulationResult.to_dataset`).
+    axes : sequence of 4 matplotlib Axes, optional
+        Panels for ground acceleration, x_b, theta and x_s; a new figure when None.
+    max_event_lines : int, optional
+        Draw at most this many impact lines (dense Zeno sequences are thinned).
+    window : "auto", None or (t0, t1), optional
+        Time axis limits [s]; "auto" shows 1-99 % of the Arias intensity and every event.
+
+    Returns
+    -------
+    numpy.ndarray of Axes
+        The four panels.
+    """
+    if hasattr(result, "data_vars"):
+        result = _DatasetResponse(result)
+    if axes is None:
+        fig, axes = _new_axes(4)
+    else:
+        axes = np.atleast_1d(axes)
+        fig = axes[0].figure
+    t = result.time
+    ax_g, ax_b, ax_t, ax_s = axes[:4]
+    a_h, a_v = result.ground_acceleration
+    ax_g.plot(t, a_h / STANDARD_GRAVITY, color="k", lw=0.7, label="horizontal")
+    if np.any(a_v):
+        ax_g.plot(t, a_v / STANDARD_GRAVITY, color="tab:purple", lw=0.6, alpha=0.8,
+                  label="vertical")
+    ax_g.set_ylabel("ground acc. [g]")
+    ax_g.legend(loc="upper right", fontsize=8, ncol=2)
+    ax_b.plot(t, 100 * result.x_b, color="tab:blue", lw=1.0)
+    ax_b.set_ylabel("block slip $x_b$ [cm]")
+    theta_c = result.system.critical_angle
+    ax_t.plot(t, 1000 * result.theta, color="tab:orange", lw=1.0)
+    ax_t.set_ylabel(r"rotation $\theta$ [mrad]")
+    peak = np.nanmax(np.abs(result.theta)) if np.isfinite(result.theta).any() else 0.0
+    if peak > 0.3 * theta_c:
+        for sgn in (1, -1):
+            ax_t.axhline(sgn * 1000 * theta_c, color="red", lw=0.8, ls="--")
+        ax_t.text(t[0], 1000 * theta_c, r" $\theta_c$ (overturning)", color="red",
+                  va="bottom", fontsize=8)
+    ax_s.plot(t, 100 * result.x_s, color="tab:green", lw=1.0)
+    ax_s.set_ylabel("ship slip $x_s$ [cm]")
+    ax_s.set_xlabel("time [s]")
+    # modes as coloured bands behind every panel
+    spans = mode_spans(t, result.mode)
+    seen = set()
+    for ax in axes[:4]:
+        for t0, t1, m in spans:
+            if m != 1 and m != 0:
+                ax.axvspan(t0, t1, color=MODE_COLOURS[m], lw=0, zorder=0)
+        ax.grid(True, lw=0.3, alpha=0.5)
+    for _, _, m in spans:
+        seen.add(m)
+    # events
+    impacts = [e for e in result.events if e.kind == "impact"]
+    stride = max(1, len(impacts) // max_event_lines)
+    for e in impacts[::stride]:
+        for ax in axes[1:4]:
+            ax.axvline(e.time, **EVENT_STYLES["impact"], zorder=1)
+    for e in result.events:
+        if e.kind in ("impact", "start"):
+            continue
+        style = EVENT_STYLES.get(e.kind)
+        if style is None:
+            continue
+        for ax in axes[1:4]:
+            ax.axvline(e.time, **style, zorder=1)
+    # legend of modes and events in the top panel's figure
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    handles = [Patch(facecolor=MODE_COLOURS[m], edgecolor="0.6", label=f"{m}: {MODE_DESCRIPTIONS[m]}")
+               for m in sorted(seen) if m >= 1]
+    kinds = {e.kind for e in result.events} - {"start"}
+    handles += [Line2D([], [], **EVENT_STYLES[k], label=k.replace("_", " ")) for k in sorted(kinds)
+                if k in EVENT_STYLES]
+    if handles:
+        axes[3].legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.35),
+                       ncol=3, fontsize=7, frameon=False)
+    if window == "auto":
+        window = active_window(t, a_h, result.events)
+    if window is not None:
+        axes[0].set_xlim(*window)
+    title = "ship-block response"
+    if result.failure:
+        title += f": {result.failure} at t = {result.failure_time:.3f} s"
+    fig.suptitle(title)
+    return axes
+
+
+def plot_record(motion, axes=None, label=None):
+    """Acceleration, velocity and displacement of a ground motion (H and, if present, V).
+
+    Parameters
+    ----------
+    motion : GroundMotion or tuple
+        A :class:`shipblock.motion.GroundMotion`, or ``(horizontal, vertical, dt)`` in m/s^2.
+    axes : sequence of 3 Axes, optional
+    label : str, optional
+        Title.
+
+    Returns
+    -------
+    numpy.ndarray of Axes
+    """
+    from shipblock import intensity
+
+    if hasattr(motion, "horizontal"):
+        h, v, dt = motion.horizontal, motion.vertical, motion.dt
+        label = label or motion.metadata.get("station") or motion.metadata.get("name")
+    else:
+        h, v, dt = motion
+    if axes is None:
+        fig, axes = _new_axes(3)
+    else:
+        axes = np.atleast_1d(axes)
+        fig = axes[0].figure
+    t = np.arange(h.size) * dt
+    for acc, name, colour in ((h, "horizontal", "k"), (v, "vertical", "tab:purple")):
+        if acc is None:
+            continue
+        axes[0].plot(t, acc / STANDARD_GRAVITY, color=colour, lw=0.6, label=name)
+        axes[1].plot(t, 100 * intensity.velocity(acc, dt), color=colour, lw=0.8)
+        axes[2].plot(t, 100 * intensity.displacement(acc, dt), color=colour, lw=0.8)
+    axes[0].set_ylabel("acceleration [g]")
+    axes[1].set_ylabel("velocity [cm/s]")
+    axes[2].set_ylabel("displacement [cm]")
+    axes[2].set_xlabel("time [s]")
+    axes[0].legend(loc="upper right", fontsize=8)
+    for ax in axes:
+        ax.grid(True, lw=0.3, alpha=0.5)
+    if label:
+        fig.suptitle(str(label))
+    return axes
+
+
+def plot_spectrum(acc, dt, periods=None, damping=0.05, ax=None, label=None, **line_kw):
+    """Pseudo-spectral acceleration Sa(T) [g] of a record (exact for piecewise-linear input).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    from shipblock import intensity
+
+    if periods is None:
+        periods = np.logspace(-2, 1, 200)
+    spec = intensity.response_spectrum(acc, dt, periods, damping)
+    if ax is None:
+        _, axs = _new_axes(1, height=3.2)
+        ax = axs[0]
+    ax.plot(spec.periods, spec.psa / STANDARD_GRAVITY, label=label, **line_kw)
+    ax.set_xscale("log")
+    ax.set_xlabel("period T [s]")
+    ax.set_ylabel(f"Sa [g] ({100 * damping:g}% damping)")
+    ax.grid(True, which="both", lw=0.3, alpha=0.5)
+    if label:
+        ax.legend(fontsize=8)
+    return ax

@@ -1,0 +1,71 @@
+"""The command line as a user meets it: outputs written, numbers consistent, errors in one line."""
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from shipblock.cli import main
+from shipblock.units import STANDARD_GRAVITY
+
+
+def run(capsys, *argv):
+    code = main(["-q", *argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_simulate_shipped_record_writes_netcdf_and_figure(tmp_path, capsys):
+    nc = tmp_path / "r.nc"
+    code, out, _ = run(capsys, "simulate", "--record", "NP.1765", "--scale", "2.6",
+                       "--mu-s-ground", "0.45", "--mu-k-ground", "0.4", "--output", str(nc))
+    assert code == 0
+    assert "peak block slip" in out and "time per mode" in out
+    assert nc.exists() and nc.with_suffix(".png").exists()
+    ds = xr.open_dataset(nc)
+    # every variable explains itself
+    for name, var in ds.variables.items():
+        assert "units" in var.attrs and "long_name" in var.attrs, name
+    # the printed peak is the stored history's peak (within the sampling of the history)
+    peak_cm = float(out.split("peak block slip |x_b|")[1].split("cm")[0])
+    assert peak_cm == pytest.approx(100 * np.nanmax(np.abs(ds["x_b"].values)), rel=0.02)
+    assert peak_cm > 1.0  # the scaled record does slide the blocks
+    # the applied scale is visible in the stored input
+    assert np.abs(ds["ground_acceleration_h"]).max() / STANDARD_GRAVITY > 1.0
+    code, out, _ = run(capsys, "plot", str(nc), "--figure", str(tmp_path / "again.png"))
+    assert code == 0 and (tmp_path / "again.png").exists()
+
+
+def test_info_reports_pga_of_the_readme_table(capsys):
+    code, out, _ = run(capsys, "info", "--record", "NP.1759", "--processing", "demean")
+    assert code == 0
+    h2 = [line for line in out.splitlines() if line.startswith("H2")][0]
+    # README of the shipped records: NP.1759 HNE PGA 0.3305 g (demeaned, sensitivity removed)
+    assert float(h2.split()[2]) == pytest.approx(0.3305, abs=0.002)
+
+
+def test_process_writes_records_and_intensity_table(tmp_path, capsys):
+    code, out, _ = run(capsys, "process", "--record", "NP.1743", "-o", str(tmp_path),
+                       "--format", "SAC")
+    assert code == 0
+    sacs = sorted(tmp_path.glob("*.sac"))
+    assert len(sacs) == 3
+    table = (tmp_path / "south-napa-2014_NP.1743_intensity.csv").read_text().splitlines()
+    assert table[0].startswith("component,pga_m_s2")
+    assert len(table) == 4
+
+
+@pytest.mark.parametrize(
+    "argv,needle",
+    [
+        (["simulate", "--record", "NP.9999"], "not in the catalogue"),
+        (["simulate", "no_such_file.mseed"], "no such file"),
+        (["simulate", "--record", "NP.1765", "--ship-mass", "-5"], "ship_mass"),
+        (["simulate", "--record", "NP.1765", "--mu-k-ship", "0.9"], "mu_k_ship"),
+        (["plot", "missing.nc"], "missing.nc"),
+    ],
+)
+def test_user_errors_are_one_line_with_exit_code_2(argv, needle, capsys):
+    code, _, err = run(capsys, *argv)
+    assert code == 2
+    assert err.startswith("shipblock: error:") and needle in err
+    assert "Traceback" not in err
