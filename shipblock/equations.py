@@ -62,7 +62,7 @@ from shipblock.system import (
 I_XB_DD, I_TH_DD, I_XS_DD, I_FX, I_FY, I_SFX, I_SFY = 0, 1, 2, 3, 4, 5, 6
 N_SOLVE_OUT = 7
 
-#: A 3x3 determinant below this fraction of the product of its row norms is singular.
+#: A 3x3 determinant below this fraction of the product of its rows' largest entries is singular.
 SINGULAR_RELATIVE = 1e-12
 
 
@@ -148,9 +148,9 @@ def solve_mode(p, slip1, rock, slip2, s, sig1, sig2, theta, omega, a, G, out):
     c2 = a10 * a21 - a11 * a20
     det = a00 * c0 + a01 * c1 + a02 * c2
     scale = (
-        math.sqrt(a00 * a00 + a01 * a01 + a02 * a02)
-        * math.sqrt(a10 * a10 + a11 * a11 + a12 * a12)
-        * math.sqrt(a20 * a20 + a21 * a21 + a22 * a22)
+        max(abs(a00), abs(a01), abs(a02))
+        * max(abs(a10), abs(a11), abs(a12))
+        * max(abs(a20), abs(a21), abs(a22))
     )
     if not abs(det) > SINGULAR_RELATIVE * scale:
         out[:] = np.nan
