@@ -350,3 +350,20 @@ def test_invalid_inputs_are_named():
                          ("impact_rule", "bounce"), ("n_blocks", 0), ("mu_k_ground", 0.9)]:
         with pytest.raises(ValueError, match=field):
             system.replace(**{field: value})
+
+
+def test_batch_entry_point_equals_single_runs():
+    """simulate_batch (parallel, summaries only) gives exactly what simulate gives per case."""
+    from shipblock import simulate_batch
+
+    a1, ay1, dt = random_record(3, n=1200)
+    a2, _, _ = random_record(4, n=900)
+    systems = [all_modes_system(), all_modes_system().replace(half_width=0.4, mu_s_ship=0.5)]
+    cases = [(0, 0, 1.0, 1.0), (1, 0, 0.7, 0.0), (0, 1, 1.3, 0.5), (1, 1, -1.0, 1.0)]
+    out = simulate_batch(systems, [(a1, ay1), (a2, None)], dt, cases)
+    for c, (r, s, fh, fv) in enumerate(cases):
+        ay = (ay1 * fv) if r == 0 else None
+        single = simulate(systems[s], (a1, a2)[r] * fh, ay, dt)
+        for key in ("peak_block_slip", "peak_rotation", "peak_ship_slip", "residual_ship_slip",
+                    "n_impacts", "time_in_mode_3"):
+            assert out[key][c] == single.summary[key], (c, key)

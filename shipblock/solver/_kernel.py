@@ -102,9 +102,17 @@ def ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt):
         tau -= dt
         k += 1
     if k >= n - 1:
-        a = ax[n - 1]
-        b = ay[n - 1] if has_ay else 0.0
-        return sh * a, sv * b
+        b = sv * ay[n - 1] if has_ay else 0.0
+        return sh * ax[n - 1], b
+    # scale the samples first, then interpolate: the same arithmetic as a pre-scaled record
+    f = tau / dt
+    a0 = sh * ax[k]
+    a = a0 + (sh * ax[k + 1] - a0) * f
+    b = 0.0
+    if has_ay:
+        b0 = sv * ay[k]
+        b = b0 + (sv * ay[k + 1] - b0) * f
+    return a, b
     f = tau / dt
     a = ax[k] + (ax[k + 1] - ax[k]) * f
     b = 0.0
