@@ -105,7 +105,7 @@ class EventKind(IntEnum):
     ROCKING_STOP = 5  #: impacts accumulated (Zeno) and rocking stopped
     SHIP_SLIP_START = 6  #: block-ship friction exceeded the static limit
     SHIP_SLIP_STOP = 7  #: ship slip velocity reached zero
-    OVERTURNING = 8  #: |theta| reached theta_c = atan(B/H): failure
+    OVERTURNING = 8  #: ``|theta|`` reached theta_c = atan(B/H): failure
     SEPARATION = 9  #: a normal force reached zero: failure
     SOLVER_ERROR = 10  #: the integrator could not continue (reported, run stopped)
 

@@ -742,16 +742,16 @@ def pad(stream, *, before=0.0, after=0.0):
 
 #: Default processing chain (read-only; :func:`default_chain` returns a mutable copy).
 #:
-#: 1. ``demean`` and 2. ``detrend(type="linear")``: remove the offset and linear trend that
+#: 1. ``demean`` and ``detrend(type="linear")``: remove the offset and linear trend that
 #:    otherwise integrate into large velocity/displacement drifts.
-#: 3. ``taper(max_percentage=0.05, type="hann")``: a 5 % cosine (Tukey) taper brings both ends
+#: 2. ``taper(max_percentage=0.05, type="hann")``: a 5 % cosine (Tukey) taper brings both ends
 #:    smoothly to zero so the filter does not ring on the step at the record ends.
-#: 4. ``bandpass(0.1-25 Hz, corners=4, zerophase=True, nyquist_cap=0.8)``: a zero-phase
+#: 3. ``bandpass(0.1-25 Hz, corners=4, zerophase=True, nyquist_cap=0.8)``: a zero-phase
 #:    Butterworth keeps peak times and the H/V phase relation the ship responds to; 0.1 Hz
 #:    removes long-period noise while keeping periods up to 10 s (well beyond the rocking and
 #:    sliding periods of a docked ship); 25 Hz removes high-frequency noise that a rigid ship
 #:    on blocks does not feel, capped at 80 % of Nyquist for coarsely sampled records.
-#: 5. ``baseline(order=6)``: removes the residual displacement drift left after filtering
+#: 4. ``baseline(order=6)``: removes the residual displacement drift left after filtering
 #:    (Ancheta et al. 2013; gmprocess; Boore & Bommer 2005).
 #:
 #: The corners are generic; records with little pre-event signal benefit from a ``pad`` step
