@@ -303,13 +303,23 @@ def cmd_run(args):
     out = sys.stdout
     out.write(f"results written to {ds.encoding.get('source', args.output or 'the pipeline output')}\n")
     if "median" in ds:
+        from shipblock.plot import _im_axis
+
         out.write("fitted fragility (lognormal):\n")
         for ls in ds["limit_state"].values:
             med = ds["median"].sel(limit_state=ls)
             beta = ds["beta"].sel(limit_state=ls)
             if med.ndim == 0:
-                units = ds["median"].attrs.get("units", "")
-                out.write(f"  {str(ls):<24} median {float(med):.4g} {units}, beta {float(beta):.3f}\n")
+                value, label, _ = _im_axis(ds, [float(med)])
+                band = ""
+                if "median_lower" in ds:
+                    lo, _, _ = _im_axis(ds, [float(ds["median_lower"].sel(limit_state=ls))])
+                    hi, _, _ = _im_axis(ds, [float(ds["median_upper"].sel(limit_state=ls))])
+                    band = f" ({lo[0]:.3g} to {hi[0]:.3g})"
+                out.write(f"  {str(ls):<24} median {label} {value[0]:.3g}{band}, "
+                          f"beta {float(beta):.3f}\n")
+            else:
+                out.write(f"  {str(ls):<24} fitted per swept parameter (see the NetCDF)\n")
     if args.figure:
         from shipblock.plot import plot_fragility
 
@@ -328,6 +338,12 @@ def cmd_plot(args):
         from shipblock.plot import plot_response
 
         _save_figure(lambda: plot_response(ds)[0].figure, figure)
+    elif "median" in ds and args.kind == "ida":
+        from shipblock.plot import plot_ida
+
+        if args.edp not in ds:
+            raise UserError(f"{args.results}: no demand parameter {args.edp!r}")
+        _save_figure(lambda: plot_ida(ds, args.edp).figure, figure)
     elif "median" in ds:
         from shipblock.plot import plot_fragility
 
@@ -392,6 +408,9 @@ def build_parser():
     s = sub.add_parser("plot", help="figure from a results NetCDF (response or fragility)")
     s.add_argument("results", help="NetCDF written by 'simulate' or 'run'")
     s.add_argument("--figure", "-o", help="PNG path (default: next to the results)")
+    s.add_argument("--kind", choices=["fragility", "ida"], default="fragility",
+                   help="for batch results: fragility curves (default) or IDA curves")
+    s.add_argument("--edp", default="peak_ship_slip", help="demand parameter of the IDA curves")
     s.set_defaults(func=cmd_plot)
 
     s = sub.add_parser("bench", help="benchmarks: samples/s, pySLAMMER comparison, batch scaling")

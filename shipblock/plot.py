@@ -273,3 +273,132 @@ def plot_spectrum(acc, dt, periods=None, damping=0.05, ax=None, label=None, **li
     if label:
         ax.legend(fontsize=8)
     return ax
+
+
+def _im_axis(ds, values):
+    """IM values for display: PGA/Sa in g, others as stored; returns (values, label)."""
+    coord = ds["im_level"] if "im_level" in ds.coords else ds.get("achieved_im")
+    attrs = coord.attrs if coord is not None else {}
+    units = attrs.get("units", "")
+    measure = str(attrs.get("measure", "im")).upper()
+    if units in ("m/s^2", "m/s**2") and measure in ("PGA", "SA", "IM"):
+        return np.asarray(values, float) / STANDARD_GRAVITY, f"{measure} [g]", STANDARD_GRAVITY
+    return np.asarray(values, float), f"{measure} [{units}]", 1.0
+
+
+def _select_sweep(da, sweep):
+    """Pick one value of every swept dimension (the first unless ``sweep`` names one)."""
+    sweep = dict(sweep or {})
+    for dim in list(da.dims):
+        if dim in ("record", "im_level", "limit_state"):
+            continue
+        da = da.sel({dim: sweep[dim]}) if dim in sweep else da.isel({dim: 0})
+    return da
+
+
+def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
+    """Fitted lognormal fragility curves with the observed fractions of exceedance.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Result of :func:`shipblock.run_pipeline` (``exceeded``, ``valid``, ``median``, ``beta``
+        and, when bootstrapped, ``median_lower``/``median_upper``).
+    limit_state : str or sequence of str, optional
+        Limit states to draw (default all).
+    ax : matplotlib Axes, optional
+    sweep : dict, optional
+        Value of each swept parameter to draw (default: the first of each).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    from scipy.stats import norm
+
+    if ax is None:
+        _, axs = _new_axes(1, height=4.0)
+        ax = axs[0]
+    names = list(ds["limit_state"].values)
+    if limit_state is not None:
+        names = [limit_state] if isinstance(limit_state, str) else list(limit_state)
+    scaled = "im_level" in ds.coords
+    x_obs_si = ds["im_level"].values if scaled else None
+    if scaled:
+        x_max = float(np.nanmax(x_obs_si)) * 1.15
+    else:
+        x_max = float(np.nanmax(ds["achieved_im"].values)) * 1.15
+    x_si = np.linspace(x_max / 400, x_max, 400)
+    x_plot, xlabel, _ = _im_axis(ds, x_si)
+    colours = [f"C{i}" for i in range(10)]
+    for i, name in enumerate(names):
+        c = colours[i % 10]
+        median = float(_select_sweep(ds["median"].sel(limit_state=name), sweep))
+        beta = float(_select_sweep(ds["beta"].sel(limit_state=name), sweep))
+        desc = name.replace("_", " ")
+        if np.isfinite(median) and np.isfinite(beta) and beta > 0:
+            med_plot, _, _ = _im_axis(ds, [median])
+            ax.plot(x_plot, norm.cdf(np.log(x_si / median) / beta), color=c, lw=1.8,
+                    label=f"{desc}: median {med_plot[0]:.3g}, beta {beta:.2f}")
+            if "median_lower" in ds:
+                lo = float(_select_sweep(ds["median_lower"].sel(limit_state=name), sweep))
+                hi = float(_select_sweep(ds["median_upper"].sel(limit_state=name), sweep))
+                if np.isfinite(lo) and np.isfinite(hi):
+                    ax.fill_between(x_plot, norm.cdf(np.log(x_si / hi) / beta),
+                                    norm.cdf(np.log(x_si / lo) / beta), color=c, alpha=0.15,
+                                    lw=0)
+        else:
+            ax.plot([], [], color=c, label=f"{desc}: no fit")
+        if scaled:
+            ex = _select_sweep(ds["exceeded"].sel(limit_state=name), sweep)
+            ok = _select_sweep(ds["valid"].sel(limit_state=name), sweep)
+            n_ex = (ex & ok).sum("record").values
+            n = ok.sum("record").values
+            frac = np.where(n > 0, n_ex / np.maximum(n, 1), np.nan)
+            xo, _, _ = _im_axis(ds, x_obs_si)
+            ax.plot(xo, frac, "o", color=c, ms=5, mfc="white", mew=1.5)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("probability of exceedance")
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlim(0, x_plot[-1])
+    ax.grid(True, lw=0.3, alpha=0.5)
+    band = " (shaded: bootstrap band of the median)" if "median_lower" in ds else ""
+    ax.set_title("fragility: lognormal fit (lines), observed fractions (circles)" + band,
+                 fontsize=9)
+    ax.legend(fontsize=8, loc="lower right")
+    return ax
+
+
+def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
+    """IDA curves: the demand ``edp`` of each record against the intensity it was scaled to.
+
+    Runs that failed (separation, overturning) are marked with a cross at the right edge.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    if ax is None:
+        _, axs = _new_axes(1, height=4.0)
+        ax = axs[0]
+    demand = _select_sweep(ds[edp], sweep)
+    failure = _select_sweep(ds["failure"], sweep) if "failure" in ds else None
+    im_si = ds["achieved_im"].values
+    units = ds[edp].attrs.get("units", "")
+    scale, unit_label = (100.0, "cm") if units == "m" else (1.0, units)
+    finite = demand.values[np.isfinite(demand.values)]
+    x_fail = (finite.max() * scale * 1.1) if finite.size else 1.0
+    for i, rec in enumerate(ds["record"].values):
+        y, ylabel, _ = _im_axis(ds, im_si[i])
+        x = demand.sel(record=rec).values * scale
+        c = f"C{i % 10}"
+        failed = (failure.sel(record=rec).values > 0) if failure is not None else np.zeros(x.size, bool)
+        ax.plot(np.where(failed, np.nan, x), y, "-o", color=c, ms=3.5, lw=1.2,
+                label=str(rec).split("/")[-1])
+        ax.plot(np.full(failed.sum(), x_fail), y[failed], "x", color=c, ms=7, mew=2)
+    ax.set_xlabel(f"{ds[edp].attrs.get('long_name', edp)} [{unit_label}]")
+    ax.set_ylabel(ylabel)
+    ax.grid(True, lw=0.3, alpha=0.5)
+    ax.set_title("IDA curves (x: failure)", fontsize=9)
+    ax.legend(fontsize=8, ncol=2)
+    return ax

@@ -258,7 +258,9 @@ def process_motion(motion, chain: Iterable[Mapping] | None = None):
     chain = DEFAULT_CHAIN if chain is None else chain
     processed = apply_chain(motion.stream, chain)
     n_old = len(motion.stream[0].stats.get("processing", [])) if len(motion.stream) else 0
-    notes = list(processed[0].stats.processing[n_old:]) if len(processed) else []
+    notes = list(processed[0].stats.get("processing", [])[n_old:]) if len(processed) else []
+    if not notes:
+        return motion  # an empty chain changes nothing
     return motion.with_stream(processed, "; ".join(notes))
 
 

@@ -69,3 +69,30 @@ def test_user_errors_are_one_line_with_exit_code_2(argv, needle, capsys):
     assert code == 2
     assert err.startswith("shipblock: error:") and needle in err
     assert "Traceback" not in err
+
+
+def test_run_demo_pipeline_prints_fits_and_draws(tmp_path, capsys):
+    """The README's main job, end to end, into a temporary output."""
+    nc = tmp_path / "demo.nc"
+    png = tmp_path / "demo.png"
+    code, out, _ = run(capsys, "run", "pipelines/demo.toml", "--output", str(nc), "--figure",
+                       str(png))
+    assert code == 0, out
+    assert nc.exists() and png.exists()
+    ds = xr.open_dataset(nc)
+    assert "median" in ds and set(ds["limit_state"].values) >= {"ship_slip"}
+    med = float(ds["median"].sel(limit_state="ship_slip")) / STANDARD_GRAVITY
+    printed = [line for line in out.splitlines() if line.strip().startswith("ship_slip ")][0]
+    assert f"{med:.3g}" in printed
+    code, _, _ = run(capsys, "plot", str(nc), "--kind", "ida", "--figure", str(tmp_path / "i.png"))
+    assert code == 0 and (tmp_path / "i.png").exists()
+
+
+def test_run_invalid_pipeline_names_the_key(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text((__import__("pathlib").Path("pipelines/demo.toml").read_text())
+                   .replace('type = "ida"', 'type = "idaa"')
+                   .replace('"../records/catalogue.toml"', '"' + str(
+                       __import__("pathlib").Path("records/catalogue.toml").resolve()) + '"'))
+    code, _, err = run(capsys, "run", str(bad), "--output", str(tmp_path / "x.nc"))
+    assert code == 2 and "design" in err and "type" in err

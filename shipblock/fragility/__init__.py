@@ -51,3 +51,28 @@ __all__ = [
     "lognormal_fragility",
     "parse_limit_states",
 ]
+from shipblock.fragility.batch import PreparedRecord, prepare_record, run_batch, run_chunk  # noqa: E402
+from shipblock.fragility.design import AnalysisDesign, IntensityDesign, apply_parameters  # noqa: E402
+from shipblock.fragility.store import ChunkStore, StoreError, open_results, write_dataset  # noqa: E402
+
+__all__ += [
+    "AnalysisDesign",
+    "ChunkStore",
+    "IntensityDesign",
+    "PreparedRecord",
+    "StoreError",
+    "apply_parameters",
+    "open_results",
+    "prepare_record",
+    "run_batch",
+    "run_chunk",
+    "write_dataset",
+]
+from shipblock.fragility.pipeline import (  # noqa: E402
+    PipelineError,
+    load_pipeline,
+    parse_pipeline,
+    run_pipeline,
+)
+
+__all__ += ["PipelineError", "load_pipeline", "parse_pipeline", "run_pipeline"]

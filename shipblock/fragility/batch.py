@@ -1,0 +1,486 @@
+"""Batch execution of an analysis design: records prepared once, cases run in chunks.
+
+The work of a design is done in three steps:
+
+1. :func:`prepare_record` reads and processes each record **once** and computes its scale
+   factors at every IM level (:func:`shipblock.scaling.scale_record`). A record that cannot be
+   read, processed or scaled keeps its error message and takes no part in the runs.
+2. :func:`run_batch` splits the case numbers into chunks (:meth:`AnalysisDesign.chunks`) and
+   runs every chunk not yet on disk with :func:`run_chunk`, either here (one
+   :func:`shipblock.simulate_batch` call per chunk, numba threads over all cores) or as Dask
+   tasks when a ``distributed.Client`` is given. Each finished chunk is written at once to a
+   :class:`~shipblock.fragility.store.ChunkStore`, so a killed batch resumes where it stopped.
+3. :func:`summary_dataset` arranges the per-case results on the design's dimensions.
+
+:func:`run_chunk` is a pure function of its arguments, so the result of a case does not depend
+on the executor or on the other cases of its chunk: local and Dask runs agree bit for bit.
+Each case runs the solver on ``factor_h * horizontal`` and ``factor_v * vertical`` (the arrays
+:func:`~shipblock.scaling.scale_record` returns), so it equals
+``shipblock.simulate(system, factor_h * h, factor_v * v, dt)`` bit for bit.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+import xarray as xr
+
+from shipblock.fragility.design import AnalysisDesign, IntensityDesign
+from shipblock.fragility.store import RUN_VARIABLES, ChunkStore, StoreError
+from shipblock.modes import Failure
+from shipblock.solver import (
+    DEFAULT_ATOL,
+    DEFAULT_RTOL,
+    DEFAULT_ZENO_OMEGA,
+    simulate_batch,
+)
+
+__all__ = [
+    "DEFAULT_CHUNK_SIZE",
+    "PreparedRecord",
+    "prepare_record",
+    "run_batch",
+    "run_chunk",
+    "summary_dataset",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Default largest number of cases per chunk [-]: large enough to keep all cores busy in one
+#: :func:`~shipblock.simulate_batch` call, small enough that a killed batch loses little.
+DEFAULT_CHUNK_SIZE = 64
+
+
+@dataclass
+class PreparedRecord:
+    """A record read, processed and scaled once, ready for the solver.
+
+    Attributes
+    ----------
+    id : str
+        Record id.
+    horizontal : numpy.ndarray or None
+        Processed horizontal acceleration the solver uses [m/s^2] (None after an error).
+    vertical : numpy.ndarray or None
+        Processed vertical acceleration, positive up [m/s^2]; None if absent.
+    dt : float
+        Sampling interval [s] (NaN after an error).
+    factor_h : numpy.ndarray, shape (n_levels,)
+        Scale factor of the horizontal at each level [-].
+    factor_v : numpy.ndarray, shape (n_levels,)
+        Scale factor of the vertical at each level [-]; NaN without a vertical, 0 when the
+        vertical is dropped.
+    achieved : numpy.ndarray, shape (n_levels,)
+        IM of the scaled horizontal at each level, measured again with
+        :mod:`shipblock.intensity` [SI units of the IM].
+    achieved_v : numpy.ndarray, shape (n_levels,)
+        Same measure of the scaled vertical (NaN without a vertical).
+    im : float
+        IM of the processed, unscaled horizontal [SI units of the IM].
+    metadata : dict
+        Provenance of the record (station, event, files, units, processing).
+    error : str or None
+        Why the record could not be used, or None.
+    """
+
+    id: str
+    horizontal: np.ndarray | None
+    vertical: np.ndarray | None
+    dt: float
+    factor_h: np.ndarray
+    factor_v: np.ndarray
+    achieved: np.ndarray
+    achieved_v: np.ndarray
+    im: float
+    metadata: dict = field(default_factory=dict)
+    error: str | None = None
+
+    @property
+    def npts(self) -> int:
+        """int: Number of samples (0 after an error)."""
+        return 0 if self.horizontal is None else int(self.horizontal.size)
+
+    def payload(self) -> tuple:
+        """The arrays a chunk task needs: ``(h, v, dt, factor_h, factor_v)``."""
+        return (self.horizontal, self.vertical, self.dt, self.factor_h, self.factor_v)
+
+    def digest(self) -> str:
+        """SHA-256 of the data and factors (part of the run fingerprint).
+
+        Returns
+        -------
+        str
+            Hex digest.
+        """
+        h = hashlib.sha256(self.id.encode())
+        h.update(str(self.error).encode())
+        for arr in (self.horizontal, self.vertical, self.factor_h, self.factor_v):
+            h.update(b"-" if arr is None else np.ascontiguousarray(arr, float).tobytes())
+        h.update(np.float64(self.dt).tobytes())
+        return h.hexdigest()
+
+
+def _failed(record_id: str, n_levels: int, error: str, metadata=None) -> PreparedRecord:
+    nan = np.full(n_levels, np.nan)
+    return PreparedRecord(record_id, None, None, float("nan"), nan, nan.copy(), nan.copy(),
+                          nan.copy(), float("nan"), dict(metadata or {}), error)
+
+
+def prepare_record(
+    record_id: str,
+    load: Callable[[], object],
+    chain: Iterable[Mapping] | None,
+    intensity: IntensityDesign,
+) -> PreparedRecord:
+    """Read, process and scale one record; never raises for a bad record.
+
+    Parameters
+    ----------
+    record_id : str
+        Record id (used in messages).
+    load : callable
+        Returns the :class:`shipblock.motion.GroundMotion` (e.g. ``entry.read``).
+    chain : iterable of mapping or None
+        Processing chain (:func:`shipblock.processing.apply_chain`); None for the default
+        chain, ``[]`` for none.
+    intensity : IntensityDesign
+        Measure, levels and vertical treatment.
+
+    Returns
+    -------
+    PreparedRecord
+        With ``error`` set (and no data) if reading, processing or scaling failed.
+    """
+    from shipblock.processing import process_motion
+    from shipblock.scaling import measure_value, scale_record
+
+    n = intensity.n_levels
+    metadata: dict = {}
+    try:
+        motion = load()
+        metadata = motion.metadata
+        if chain is None or list(chain):  # process_motion fails on an empty chain
+            motion = process_motion(motion, chain)
+            metadata = motion.metadata
+        h = np.ascontiguousarray(motion.horizontal, dtype=float)
+        v = motion.vertical
+        v = None if v is None else np.ascontiguousarray(v, dtype=float)
+        dt = float(motion.dt)
+        fh, fv, ach, ach_v = (np.full(n, np.nan) for _ in range(4))
+        for j in range(n):
+            s = scale_record(h, v, dt, **intensity.scale_options(j))
+            fh[j] = s.factor_h
+            ach[j] = s.achieved
+            if s.factor_v is not None:
+                fv[j] = s.factor_v
+                ach_v[j] = s.achieved_v
+        im = measure_value(h, dt, intensity.measure, intensity.period, intensity.damping)
+    except Exception as exc:  # noqa: BLE001 - a bad record is reported, the batch goes on
+        message = f"{type(exc).__name__}: {exc}"
+        logger.warning("record %s left out: %s", record_id, message)
+        return _failed(record_id, n, message, metadata)
+    return PreparedRecord(record_id, h, v, dt, fh, fv, ach, ach_v, float(im), metadata)
+
+
+# --------------------------------------------------------------------------------------------
+# one chunk
+# --------------------------------------------------------------------------------------------
+
+
+def run_chunk(records, systems, cases, *, rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL,
+              zeno_omega=DEFAULT_ZENO_OMEGA) -> dict:
+    """Run the cases of one chunk with one :func:`shipblock.simulate_batch` call.
+
+    Pure: the output depends only on the arguments (safe as a Dask task).
+
+    Parameters
+    ----------
+    records : sequence of tuple
+        ``(h, v, dt, factor_h, factor_v)`` per record (see :meth:`PreparedRecord.payload`):
+        accelerations [m/s^2], sampling interval [s], factors per level [-].
+    systems : sequence of ShipBlockSystem
+        The systems the cases refer to.
+    cases : array_like of int, shape (n, 3)
+        ``(record index into records, level index, system index)`` per case.
+    rtol, atol, zeno_omega : float
+        Solver tolerances (see :func:`shipblock.simulate`).
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        The summary arrays of :func:`~shipblock.simulate_batch`, one value per case.
+    """
+    cases = np.asarray(cases, dtype=np.int64).reshape(-1, 3)
+    pairs, pair_of_case = np.unique(cases[:, :2], axis=0, return_inverse=True)
+    inputs, dts = [], []
+    for r, j in pairs:
+        h, v, dt, fh, fv = records[r]
+        f_v = fv[j]
+        vertical = None if v is None or not np.isfinite(f_v) or f_v == 0.0 else f_v * v
+        inputs.append((fh[j] * h, vertical))
+        dts.append(dt)
+    batch = np.column_stack([pair_of_case.ravel(), cases[:, 2], np.ones(len(cases)),
+                             np.ones(len(cases))])
+    return simulate_batch(list(systems), inputs, dts, batch, rtol=rtol, atol=atol,
+                          zeno_omega=zeno_omega)
+
+
+def _mark_solver_errors(out: dict) -> np.ndarray:
+    """Turn runs with failure code 3 into NaN results and return their error messages."""
+    failure = out["failure"]
+    messages = np.full(failure.shape, "", dtype="U80")
+    bad = failure == int(Failure.SOLVER_ERROR)
+    for i in np.flatnonzero(bad):
+        messages[i] = (f"solver error (failure code {int(Failure.SOLVER_ERROR)}) at "
+                       f"t = {out['failure_time'][i]:.6g} s")
+    for name in out:
+        out[name] = np.where(bad, np.nan, out[name])
+    return messages
+
+
+# --------------------------------------------------------------------------------------------
+# the batch
+# --------------------------------------------------------------------------------------------
+
+
+class _Task:
+    """What one chunk needs: its cases, the runnable ones and their local indices."""
+
+    def __init__(self, design: AnalysisDesign, chunk: range, ok_records: np.ndarray):
+        self.cases = np.arange(chunk.start, chunk.stop, dtype=np.int64)
+        idx = design.case_indices(self.cases)
+        self.runnable = ok_records[idx[:, 0]]
+        idx = idx[self.runnable]
+        self.records, local = np.unique(idx[:, 0], return_inverse=True)
+        self.local_cases = np.column_stack([local.ravel(), idx[:, 1], idx[:, 2]])
+
+    def assemble(self, out: dict | None) -> dict:
+        """Full-chunk arrays (NaN for cases of failed records) from the solver output."""
+        n = self.cases.size
+        arrays = {name: np.full(n, np.nan) for name in RUN_VARIABLES}
+        errors = np.full(n, "", dtype="U80")
+        if out is not None:
+            out = {k: np.asarray(v, dtype=float) for k, v in out.items()}
+            msg = _mark_solver_errors(out)
+            for name in RUN_VARIABLES:
+                arrays[name][self.runnable] = out[name]
+            errors[self.runnable] = msg
+        arrays["run_error"] = errors
+        return arrays
+
+
+def run_batch(
+    design: AnalysisDesign,
+    records: list[PreparedRecord],
+    store: ChunkStore,
+    *,
+    chunk_size: int = DEFAULT_CHUNK_SIZE,
+    client=None,
+    progress: bool = True,
+    solver_options: Mapping | None = None,
+) -> dict:
+    """Run every case of a design, resuming from the chunks already in ``store``.
+
+    Parameters
+    ----------
+    design : AnalysisDesign
+        The grid of runs.
+    records : list of PreparedRecord
+        One per ``design.records``, in order.
+    store : ChunkStore
+        Where finished chunks are written (opened by the caller).
+    chunk_size : int
+        Largest number of cases per chunk.
+    client : distributed.Client, optional
+        Run chunks as Dask tasks on this client; None runs them here.
+    progress : bool
+        Show a tqdm progress bar (runs done, rate, time left).
+    solver_options : mapping, optional
+        ``rtol``, ``atol``, ``zeno_omega`` for :func:`run_chunk`.
+
+    Returns
+    -------
+    dict of numpy.ndarray
+        One array of length ``design.n_cases`` per name of
+        :data:`~shipblock.fragility.store.RUN_VARIABLES` (NaN for runs without a result) and
+        ``run_error`` (strings, empty for good runs).
+    """
+    from tqdm.auto import tqdm
+
+    opts = dict(solver_options or {})
+    systems = design.systems()
+    chunks = design.chunks(chunk_size)
+    n = design.n_cases
+    results = {name: np.full(n, np.nan) for name in RUN_VARIABLES}
+    results["run_error"] = np.full(n, "", dtype=object)
+
+    def fill(chunk: range, arrays: dict):
+        for name, values in arrays.items():
+            if name in results:
+                results[name][chunk.start:chunk.stop] = values
+
+    pending = []
+    done_cases = 0
+    available = store.completed()
+    for k, chunk in enumerate(chunks):
+        if k in available:
+            try:
+                cases, arrays = store.read(k)
+            except StoreError as exc:
+                logger.warning("%s; recomputing it", exc)
+                store.discard(k)
+            else:
+                if np.array_equal(cases, np.arange(chunk.start, chunk.stop)):
+                    fill(chunk, arrays)
+                    done_cases += len(chunk)
+                    continue
+                store.discard(k)
+        pending.append(k)
+    if done_cases:
+        logger.info("resuming: %d of %d runs already done", done_cases, n)
+
+    ok = np.array([r.error is None for r in records], dtype=bool)
+    bar = tqdm(total=n, initial=done_cases, unit="run", desc="shipblock", disable=not progress,
+               smoothing=0.1)
+    try:
+        tasks = {k: _Task(design, chunks[k], ok) for k in pending}
+
+        def finish(k: int, out):
+            arrays = tasks[k].assemble(out)
+            store.write(k, tasks[k].cases, arrays)
+            fill(chunks[k], arrays)
+            bar.update(len(chunks[k]))
+
+        runnable = [k for k in pending if tasks[k].local_cases.size]
+        for k in pending:
+            if k not in runnable:
+                finish(k, None)
+        if client is None:
+            for k in runnable:
+                t = tasks[k]
+                payload = [records[r].payload() for r in t.records]
+                finish(k, run_chunk(payload, systems, t.local_cases, **opts))
+        else:
+            _run_dask(client, records, systems, tasks, runnable, opts, finish)
+    finally:
+        bar.close()
+    return results
+
+
+def _run_dask(client, records, systems, tasks, runnable, opts, finish):
+    """Submit the runnable chunks as Dask tasks and finish them as they complete."""
+    from distributed import as_completed
+
+    needed = sorted({int(r) for k in runnable for r in tasks[k].records})
+    scattered = {r: client.scatter(records[r].payload(), hash=False) for r in needed}
+    sys_future = client.scatter(systems, hash=False, broadcast=True)
+    futures = {}
+    for k in runnable:
+        t = tasks[k]
+        fut = client.submit(run_chunk, [scattered[int(r)] for r in t.records], sys_future,
+                            t.local_cases, pure=False, **opts)
+        futures[fut] = k
+    try:
+        for fut in as_completed(futures):
+            finish(futures[fut], fut.result())
+    finally:
+        client.cancel(list(futures))
+
+
+# --------------------------------------------------------------------------------------------
+# dataset
+# --------------------------------------------------------------------------------------------
+
+
+def summary_dataset(design: AnalysisDesign, records: list[PreparedRecord],
+                    results: Mapping) -> xr.Dataset:
+    """Arrange per-case results and record data on the design's dimensions.
+
+    Parameters
+    ----------
+    design : AnalysisDesign
+        The grid.
+    records : list of PreparedRecord
+        One per record of the design.
+    results : mapping
+        As returned by :func:`run_batch`.
+
+    Returns
+    -------
+    xarray.Dataset
+        Per-run variables of :data:`~shipblock.fragility.store.RUN_VARIABLES` and
+        ``run_error`` on ``design.dims``; per record and level ``scale_factor``,
+        ``vertical_scale_factor``, ``achieved_im``, ``achieved_im_vertical``; per record
+        ``record_error``, ``record_dt``, ``record_npts``, ``record_im``. All with ``units`` and
+        ``long_name``.
+    """
+    intensity = design.intensity
+    dims = design.dims
+    shape = design.shape
+    cloud = not intensity.scaled
+
+    def grid(values):
+        arr = np.asarray(values).reshape(shape)
+        return arr[:, 0] if cloud else arr
+
+    data = {}
+    for name, (units, long_name) in RUN_VARIABLES.items():
+        data[name] = (dims, grid(results[name]), {"units": units, "long_name": long_name})
+    data["run_error"] = (
+        dims, grid(np.asarray(results["run_error"], dtype=object)),
+        {"units": "1", "long_name": "solver error of the run (empty if none)"},
+    )
+    im_units = intensity.units
+    lvl_dims = ("record",) if cloud else ("record", "im_level")
+
+    def per_level(attr):
+        arr = np.array([getattr(r, attr) for r in records], dtype=float)
+        return arr[:, 0] if cloud else arr
+
+    data["scale_factor"] = (lvl_dims, per_level("factor_h"),
+                            {"units": "1", "long_name": "scale factor of the horizontal"})
+    data["vertical_scale_factor"] = (
+        lvl_dims, per_level("factor_v"),
+        {"units": "1", "long_name": f"scale factor of the vertical (mode {intensity.vertical!r};"
+                                    " NaN without vertical)"},
+    )
+    data["achieved_im"] = (lvl_dims, per_level("achieved"),
+                           {"units": im_units,
+                            "long_name": f"achieved {intensity.long_name} after scaling"})
+    data["achieved_im_vertical"] = (
+        lvl_dims, per_level("achieved_v"),
+        {"units": im_units, "long_name": f"{intensity.measure.upper()} of the scaled vertical"},
+    )
+    data["record_error"] = (
+        ("record",), np.array([r.error or "" for r in records], dtype=object),
+        {"units": "1", "long_name": "why the record was left out (empty if used)"},
+    )
+    data["record_dt"] = (("record",), np.array([r.dt for r in records], dtype=float),
+                         {"units": "s", "long_name": "sampling interval of the processed record"})
+    data["record_npts"] = (("record",), np.array([r.npts for r in records], dtype=np.int64),
+                           {"units": "1", "long_name": "number of samples of the processed record"})
+    data["record_im"] = (("record",), np.array([r.im for r in records], dtype=float),
+                         {"units": im_units,
+                          "long_name": f"{intensity.long_name}, processed record as recorded"})
+    coords = design.coords()
+    return xr.Dataset(data, coords={k: xr.Variable(*v) for k, v in coords.items()})
+
+
+def records_provenance(records: list[PreparedRecord]) -> str:
+    """JSON text of every record's metadata and error (for a global attribute).
+
+    Parameters
+    ----------
+    records : list of PreparedRecord
+
+    Returns
+    -------
+    str
+    """
+    doc = {r.id: {"error": r.error, **r.metadata} for r in records}
+    return json.dumps(doc, default=str, sort_keys=True)

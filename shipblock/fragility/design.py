@@ -1,0 +1,500 @@
+r"""Analysis designs: records x intensity levels x system parameters.
+
+An :class:`AnalysisDesign` is the grid of runs of a fragility study:
+
+* ``record``: the ground-motion records (catalogue ids);
+* ``im_level``: the intensity levels each record is scaled to (IDA and MSA), in SI units of the
+  scaling measure (PGA and Sa [m/s^2], PGV [m/s]); absent for a cloud analysis of unscaled
+  records;
+* one dimension per swept system parameter (:data:`SWEEP_PARAMETERS`), named after it.
+
+Every run (a *case*) is one point of that grid. Cases are numbered in C order over the dims
+``(record, im_level, *sweep)``, so the case number alone locates a run; a *chunk* is a
+contiguous range of case numbers (:meth:`AnalysisDesign.chunks`), the unit of work that is sent
+to :func:`shipblock.simulate_batch`, written to disk when done and never recomputed.
+
+Swept parameters are any field of :class:`shipblock.ShipBlockSystem` plus four conveniences:
+
+``slenderness``
+    :math:`B/H` [-]; ``half_height`` is kept and ``half_width = slenderness * half_height``.
+``mass_ratio``
+    :math:`nm/M` [-]; ``ship_mass`` and ``n_blocks`` are kept and
+    ``block_mass = mass_ratio * ship_mass / n_blocks``.
+``mu_ground``, ``mu_ship``
+    The static friction coefficient of an interface [-]; the kinetic one keeps its ratio to the
+    static one in the base system (``mu_k = mu * mu_k_base / mu_s_base``), so a sweep never
+    produces kinetic friction above static friction.
+
+Conveniences are applied after the plain fields, so ``half_height`` and ``slenderness`` may be
+swept together (the width follows the height).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+
+from shipblock.intensity import DEFAULT_DAMPING
+from shipblock.system import ShipBlockSystem
+
+__all__ = [
+    "DESIGN_TYPES",
+    "IM_MEASURES",
+    "SWEEP_PARAMETERS",
+    "VERTICAL_MODES",
+    "AnalysisDesign",
+    "IntensityDesign",
+    "SYSTEM_FIELDS",
+    "apply_parameters",
+    "as_sweep",
+]
+
+#: Analysis types: incremental dynamic analysis, multiple-stripe analysis, cloud analysis.
+DESIGN_TYPES = ("ida", "msa", "cloud")
+
+#: Scaling intensity measures of the horizontal: name -> (SI unit, long name).
+IM_MEASURES: Mapping[str, tuple[str, str]] = {
+    "pga": ("m/s^2", "peak ground acceleration of the horizontal"),
+    "pgv": ("m/s", "peak ground velocity of the horizontal"),
+    "sa": ("m/s^2", "pseudo-spectral acceleration Sa(T) of the horizontal"),
+}
+
+#: Treatment of the vertical component (see :func:`shipblock.scaling.scale_record`): scaled by
+#: the horizontal factor (keeps V/H), scaled to its own levels, left unscaled, or dropped.
+VERTICAL_MODES = ("same", "independent", "unscaled", "zero")
+
+#: Parameters that may be swept: name -> (units, long name). The plain names are fields of
+#: :class:`~shipblock.ShipBlockSystem`; see the module docstring for the conveniences.
+SWEEP_PARAMETERS: Mapping[str, tuple[str, str]] = {
+    "ship_mass": ("kg", "ship mass M"),
+    "block_mass": ("kg", "mass of one keel block m"),
+    "n_blocks": ("1", "number of keel blocks n"),
+    "half_width": ("m", "block half width B"),
+    "half_height": ("m", "block half height H"),
+    "mu_s_ground": ("1", "static friction coefficient, blocks on ground"),
+    "mu_k_ground": ("1", "kinetic friction coefficient, blocks on ground"),
+    "mu_s_ship": ("1", "static friction coefficient, ship on blocks"),
+    "mu_k_ship": ("1", "kinetic friction coefficient, ship on blocks"),
+    "restitution": ("1", "coefficient of restitution of rocking impacts"),
+    "block_inertia": ("kg m^2", "centroidal inertia of one block I"),
+    "g": ("m/s^2", "acceleration of gravity"),
+    "slenderness": ("1", "block slenderness B/H (half width over half height)"),
+    "mass_ratio": ("1", "total block mass over ship mass nm/M"),
+    "mu_ground": ("1", "static friction coefficient blocks-ground (kinetic/static ratio kept)"),
+    "mu_ship": ("1", "static friction coefficient ship-blocks (kinetic/static ratio kept)"),
+}
+
+_CONVENIENCES = ("slenderness", "mass_ratio", "mu_ground", "mu_ship")
+_CONFLICTS = {
+    "slenderness": ("half_width",),
+    "mass_ratio": ("block_mass",),
+    "mu_ground": ("mu_s_ground", "mu_k_ground"),
+    "mu_ship": ("mu_s_ship", "mu_k_ship"),
+}
+
+
+def apply_parameters(system: ShipBlockSystem, values: Mapping[str, object]) -> ShipBlockSystem:
+    """Return ``system`` with some parameters (plain fields or conveniences) changed.
+
+    Parameters
+    ----------
+    system : ShipBlockSystem
+        The base system.
+    values : Mapping[str, object]
+        Parameter name (a key of :data:`SWEEP_PARAMETERS`) -> value, in the units listed there.
+
+    Returns
+    -------
+    ShipBlockSystem
+        The changed, validated system.
+
+    Raises
+    ------
+    ValueError
+        If a name is unknown, two names set the same field (e.g. ``slenderness`` and
+        ``half_width``), or the resulting system is invalid (the message of
+        :class:`~shipblock.ShipBlockSystem` names the field).
+    """
+    unknown = [k for k in values if k not in SWEEP_PARAMETERS]
+    if unknown:
+        raise ValueError(
+            f"unknown system parameter(s) {', '.join(map(repr, unknown))}; known: "
+            f"{', '.join(SWEEP_PARAMETERS)}"
+        )
+    for conv, plain in _CONFLICTS.items():
+        clash = [p for p in plain if conv in values and p in values]
+        if clash:
+            raise ValueError(f"{conv!r} and {clash[0]!r} both set the same parameter; give one")
+    plain = {k: v for k, v in values.items() if k not in _CONVENIENCES}
+    if "n_blocks" in plain:
+        plain["n_blocks"] = _whole(plain["n_blocks"], "n_blocks")
+    out = system.replace(**plain) if plain else system
+    changes = {}
+    if "slenderness" in values:
+        changes["half_width"] = float(values["slenderness"]) * out.half_height
+    if "mass_ratio" in values:
+        changes["block_mass"] = float(values["mass_ratio"]) * out.ship_mass / out.n_blocks
+    for iface in ("ground", "ship"):
+        key = f"mu_{iface}"
+        if key in values:
+            mu = float(values[key])
+            mus, muk = getattr(system, f"mu_s_{iface}"), getattr(system, f"mu_k_{iface}")
+            ratio = muk / mus if mus > 0 else 1.0
+            changes[f"mu_s_{iface}"] = mu
+            changes[f"mu_k_{iface}"] = mu * ratio
+    return out.replace(**changes) if changes else out
+
+
+def _whole(value, name):
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise ValueError(f"{name} must be a whole number, got {value!r}")
+    if int(value) != value:
+        raise ValueError(f"{name} must be a whole number, got {value!r}")
+    return int(value)
+
+
+@dataclass(frozen=True)
+class IntensityDesign:
+    """How records are scaled: analysis type, intensity measure and levels.
+
+    Construction does no checking; call :meth:`validate`.
+
+    Attributes
+    ----------
+    kind : {"ida", "msa", "cloud"}
+        Incremental dynamic analysis (each record scaled to every level, fitted with
+        :func:`~shipblock.fragility.fit.fit_ida`), multiple-stripe analysis (same runs, fitted
+        per stripe with :func:`~shipblock.fragility.fit.fit_msa`) or cloud analysis (unscaled
+        records, :func:`~shipblock.fragility.fit.fit_cloud`).
+    measure : {"pga", "pgv", "sa"}
+        Scaling intensity measure of the horizontal component.
+    levels : tuple of float
+        Target IM levels in SI units of the measure ([m/s^2] for PGA and Sa, [m/s] for PGV),
+        positive and strictly increasing; empty for a cloud.
+    period : float or None
+        Oscillator period for ``measure="sa"`` [s].
+    damping : float
+        Fraction of critical damping for ``measure="sa"`` [-].
+    vertical : {"same", "independent", "unscaled", "zero"}
+        Treatment of the vertical component; ``"same"`` (default) multiplies it by the
+        horizontal factor, which keeps the record's V/H ratio.
+    vertical_levels : tuple of float or None
+        For ``vertical="independent"``: target of the same measure for the vertical at each
+        level, SI units.
+    """
+
+    kind: str
+    measure: str = "pga"
+    levels: tuple[float, ...] = ()
+    period: float | None = None
+    damping: float = DEFAULT_DAMPING
+    vertical: str = "same"
+    vertical_levels: tuple[float, ...] | None = None
+
+    @property
+    def units(self) -> str:
+        """str: SI unit of the intensity measure."""
+        return IM_MEASURES[self.measure][0]
+
+    @property
+    def scaled(self) -> bool:
+        """bool: Whether records are scaled to levels (IDA, MSA) rather than used as recorded."""
+        return self.kind != "cloud"
+
+    @property
+    def n_levels(self) -> int:
+        """int: Number of scaling levels (1 for a cloud: the record as recorded)."""
+        return len(self.levels) if self.scaled else 1
+
+    @property
+    def long_name(self) -> str:
+        """str: Description of the IM, with the period for Sa."""
+        name = IM_MEASURES[self.measure][1]
+        if self.measure == "sa":
+            name += f" at T = {self.period:g} s, {100 * self.damping:g} % damping"
+        return name
+
+    def validate(self) -> IntensityDesign:
+        """Check the design and return it unchanged.
+
+        Returns
+        -------
+        IntensityDesign
+            ``self``.
+
+        Raises
+        ------
+        ValueError
+            Naming the offending field.
+        """
+        if self.kind not in DESIGN_TYPES:
+            raise ValueError(f"type must be one of {DESIGN_TYPES}, got {self.kind!r}")
+        if self.measure not in IM_MEASURES:
+            raise ValueError(f"measure must be one of {tuple(IM_MEASURES)}, got {self.measure!r}")
+        if self.measure == "sa":
+            if self.period is None or not (math.isfinite(self.period) and self.period > 0):
+                raise ValueError(f"period [s] must be > 0 for measure 'sa', got {self.period!r}")
+        elif self.period is not None:
+            raise ValueError(f"period applies only to measure 'sa', not {self.measure!r}")
+        if not (0.0 <= self.damping < 1.0):
+            raise ValueError(f"damping must lie in [0, 1), got {self.damping!r}")
+        if self.vertical not in VERTICAL_MODES:
+            raise ValueError(f"vertical must be one of {VERTICAL_MODES}, got {self.vertical!r}")
+        levels = np.asarray(self.levels, dtype=float)
+        if self.scaled:
+            if levels.size == 0:
+                raise ValueError(f"a {self.kind!r} design needs at least one IM level")
+            if not (np.all(np.isfinite(levels)) and np.all(levels > 0)):
+                raise ValueError("levels must be finite and positive")
+            if np.any(np.diff(levels) <= 0):
+                raise ValueError("levels must be strictly increasing")
+        elif levels.size:
+            raise ValueError("a 'cloud' design uses the records as recorded; remove the levels")
+        if self.vertical == "independent":
+            if not self.scaled:
+                raise ValueError("vertical 'independent' needs scaled levels (not a cloud)")
+            v = np.asarray(self.vertical_levels if self.vertical_levels is not None else [])
+            if v.shape != levels.shape:
+                raise ValueError(
+                    f"vertical_levels must give one vertical target per level ({levels.size})"
+                )
+            if not (np.all(np.isfinite(v)) and np.all(v > 0)):
+                raise ValueError("vertical_levels must be finite and positive")
+        elif self.vertical_levels is not None:
+            raise ValueError("vertical_levels apply only to vertical = 'independent'")
+        return self
+
+    def scale_options(self, level_index: int) -> dict:
+        """Keyword arguments of :func:`shipblock.scaling.scale_record` for one level.
+
+        Parameters
+        ----------
+        level_index : int
+            Index into :attr:`levels` (ignored for a cloud).
+
+        Returns
+        -------
+        dict
+            ``target``/``factor``, ``measure``, ``period``, ``damping``, ``vertical_mode`` and,
+            for an independent vertical, ``vertical_target``.
+        """
+        opts = {"measure": self.measure, "period": self.period, "damping": self.damping}
+        if self.scaled:
+            opts["target"] = float(self.levels[level_index])
+        else:
+            opts["factor"] = 1.0
+        opts["vertical_mode"] = self.vertical
+        if self.vertical == "independent":
+            opts["vertical_target"] = float(self.vertical_levels[level_index])
+        return opts
+
+
+@dataclass(frozen=True)
+class AnalysisDesign:
+    """The grid of runs: records x IM levels x swept system parameters.
+
+    Attributes
+    ----------
+    records : tuple of str
+        Record ids (catalogue ids), the ``record`` dimension.
+    intensity : IntensityDesign
+        Analysis type, IM and levels (the ``im_level`` dimension, absent for a cloud).
+    system : ShipBlockSystem
+        The base system.
+    sweep : tuple of (str, tuple)
+        ``(parameter, values)`` pairs, one dimension each, in order.
+    """
+
+    records: tuple[str, ...]
+    intensity: IntensityDesign
+    system: ShipBlockSystem
+    sweep: tuple[tuple[str, tuple], ...] = field(default_factory=tuple)
+
+    def validate(self) -> AnalysisDesign:
+        """Check the grid and build every swept system once.
+
+        Returns
+        -------
+        AnalysisDesign
+            ``self``.
+
+        Raises
+        ------
+        ValueError
+            For no records, repeated record ids, an unknown or repeated sweep parameter, an
+            empty or repeated list of values, or an invalid swept system (the message names
+            the parameter values).
+        """
+        if not self.records:
+            raise ValueError("the design has no records")
+        if len(set(self.records)) != len(self.records):
+            raise ValueError("record ids repeat in the design")
+        self.intensity.validate()
+        names = [name for name, _ in self.sweep]
+        if len(set(names)) != len(names):
+            raise ValueError("a parameter is swept twice")
+        for name, values in self.sweep:
+            if name not in SWEEP_PARAMETERS:
+                raise ValueError(
+                    f"unknown sweep parameter {name!r}; known: {', '.join(SWEEP_PARAMETERS)}"
+                )
+            if len(values) == 0:
+                raise ValueError(f"sweep {name!r} has no values")
+            if len(set(values)) != len(values):
+                raise ValueError(f"sweep {name!r} repeats a value")
+        self.systems()
+        return self
+
+    # -- grid --------------------------------------------------------------------------------
+    @property
+    def sweep_names(self) -> tuple[str, ...]:
+        """tuple of str: Names of the swept parameters (= their dimension names)."""
+        return tuple(name for name, _ in self.sweep)
+
+    @property
+    def dims(self) -> tuple[str, ...]:
+        """tuple of str: Dimensions of a per-run variable, in case order."""
+        level = ("im_level",) if self.intensity.scaled else ()
+        return ("record", *level, *self.sweep_names)
+
+    @property
+    def sweep_shape(self) -> tuple[int, ...]:
+        """tuple of int: Number of values of each swept parameter."""
+        return tuple(len(values) for _, values in self.sweep)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """tuple of int: Shape of the grid ``(n_records, n_levels, *sweep_shape)``.
+
+        The level axis is always present here (length 1 for a cloud), so that case numbers
+        are computed the same way for every design type; :attr:`dims` drops it for a cloud.
+        """
+        return (len(self.records), self.intensity.n_levels, *self.sweep_shape)
+
+    @property
+    def n_cases(self) -> int:
+        """int: Number of runs."""
+        return int(np.prod(self.shape))
+
+    @property
+    def n_systems(self) -> int:
+        """int: Number of system-parameter combinations."""
+        return int(np.prod(self.sweep_shape)) if self.sweep else 1
+
+    def systems(self) -> list[ShipBlockSystem]:
+        """Every swept system, in C order over the sweep dimensions.
+
+        Returns
+        -------
+        list of ShipBlockSystem
+            ``n_systems`` systems; a design without a sweep has just the base system.
+
+        Raises
+        ------
+        ValueError
+            If a combination gives an invalid system (names the combination).
+        """
+        out = []
+        for combo in itertools.product(*(values for _, values in self.sweep)):
+            values = dict(zip(self.sweep_names, combo, strict=True))
+            try:
+                out.append(apply_parameters(self.system, values))
+            except ValueError as exc:
+                raise ValueError(f"sweep {values}: {exc}") from None
+        return out
+
+    def case_indices(self, cases) -> np.ndarray:
+        """Grid indices of case numbers.
+
+        Parameters
+        ----------
+        cases : array_like of int
+            Case numbers in ``[0, n_cases)``.
+
+        Returns
+        -------
+        numpy.ndarray of int, shape (n, 3)
+            Columns ``(record index, level index, system index)``.
+        """
+        idx = np.unravel_index(np.asarray(cases, dtype=np.int64), self.shape)
+        system = (
+            np.ravel_multi_index(idx[2:], self.sweep_shape)
+            if self.sweep
+            else np.zeros_like(idx[0])
+        )
+        return np.stack([idx[0], idx[1], system], axis=1).astype(np.int64)
+
+    def chunks(self, chunk_size: int) -> list[range]:
+        """Split the case numbers into contiguous chunks.
+
+        Parameters
+        ----------
+        chunk_size : int
+            Largest number of cases per chunk, >= 1.
+
+        Returns
+        -------
+        list of range
+            Consecutive ranges covering ``range(n_cases)``.
+        """
+        if int(chunk_size) != chunk_size or chunk_size < 1:
+            raise ValueError(f"chunk_size must be a whole number >= 1, got {chunk_size!r}")
+        n = self.n_cases
+        return [range(a, min(a + int(chunk_size), n)) for a in range(0, n, int(chunk_size))]
+
+    def coords(self) -> dict:
+        """Coordinates of the grid as ``{name: (dims, values, attrs)}``.
+
+        Returns
+        -------
+        dict
+            ``record``, ``im_level`` (scaled designs, SI units) and one per swept parameter,
+            each with ``units`` and ``long_name``.
+        """
+        out = {
+            "record": (("record",), np.array(self.records, dtype=object),
+                       {"long_name": "ground-motion record (catalogue id)", "units": "1"}),
+        }
+        if self.intensity.scaled:
+            out["im_level"] = (
+                ("im_level",),
+                np.asarray(self.intensity.levels, dtype=float),
+                {
+                    "long_name": f"target intensity level: {self.intensity.long_name}",
+                    "units": self.intensity.units,
+                    "measure": self.intensity.measure,
+                },
+            )
+        for name, values in self.sweep:
+            units, long_name = SWEEP_PARAMETERS[name]
+            arr = np.asarray(values)
+            if arr.dtype.kind in "iu":
+                arr = arr.astype(np.int64)
+            elif arr.dtype.kind == "f":
+                arr = arr.astype(float)
+            out[name] = ((name,), arr, {"long_name": f"swept parameter: {long_name}",
+                                        "units": units})
+        return out
+
+
+def as_sweep(mapping: Mapping[str, Sequence]) -> tuple[tuple[str, tuple], ...]:
+    """Turn ``{parameter: [values]}`` into the ``sweep`` tuple of :class:`AnalysisDesign`.
+
+    Parameters
+    ----------
+    mapping : Mapping[str, Sequence]
+        Parameter name -> values, in dimension order.
+
+    Returns
+    -------
+    tuple of (str, tuple)
+    """
+    return tuple((str(k), tuple(v)) for k, v in mapping.items())
+
+
+#: ShipBlockSystem constructor fields (for validation of system tables).
+SYSTEM_FIELDS = tuple(f.name for f in fields(ShipBlockSystem))

@@ -1,0 +1,899 @@
+r"""Pipelines: a TOML file that fully reproduces a fragility study, and :func:`run_pipeline`.
+
+A pipeline file names the records (a catalogue and record ids), the processing chain, the
+component, the ship-block system and the parameters swept, the analysis design (IDA, MSA or
+cloud; scaling IM and levels), the limit states, the fit and solver options and the output
+file. :func:`load_pipeline` parses and validates it (every error names the offending key) and
+:func:`run_pipeline` runs it end to end: records read and processed once, all runs in chunks
+(locally or on Dask), exceedance of every limit state, lognormal fragility fits with bootstrap
+bounds over records, and one NetCDF file.
+
+Schema (``schema_version = 1``; units in brackets, paths relative to the pipeline file)::
+
+    schema_version = 1
+    title = "..."                       # optional
+    output = "results/demo.nc"          # required
+
+    [records]
+    catalogue = "../records/catalogue.toml"   # optional; default: the shipped catalogue
+    ids = "all"                         # or a list of catalogue ids
+    azimuth = 0.0                       # dock transverse axis [deg from north], or
+    horizontal = "H1"                   # one horizontal as recorded (default "H1")
+    response = "sensitivity"            # or "full" (instrument response removal)
+
+    [[processing]]                      # optional; absent: shipblock.processing.DEFAULT_CHAIN
+    step = "demean"                     # processing = [] for no processing
+
+    [system]                            # ShipBlockSystem fields [SI]; slenderness = B/H may
+    ship_mass = 5.0e6                   # replace half_width
+    ...
+
+    [sweep]                             # optional; one dimension per parameter
+    mu_ground = [0.3, 0.4, 0.5]
+    slenderness = [0.4, 0.5, 0.6]
+
+    [design]
+    type = "ida"                        # "ida", "msa" or "cloud"
+    measure = "pga"                     # "pga" (default), "pgv" or "sa" (then period [s])
+    levels_g = [0.1, 0.2, 0.4]          # or levels = [...] with units = "m/s^2" ("m/s" for PGV)
+    vertical = "same"                   # "same", "independent" (+ vertical_levels[_g]),
+                                        # "unscaled" or "zero"
+    cloud_method = "probit"             # cloud only: "probit" or "regression"
+
+    [[limit_states]]                    # see shipblock.fragility.limit_states
+    name = "block_slip"
+    edp = "peak_block_slip"
+    threshold = 0.02                    # [m]
+
+    [fit]
+    bootstrap = 200                     # resamples over records (0: no bounds)
+    confidence = 0.9
+    seed = 1
+    ida_method = "mle"                  # or "moments"
+
+    [solver]
+    rtol = 1e-8
+    atol = 1e-10
+    zeno_omega = 1e-7                   # [rad/s]
+
+    [execution]
+    chunk_size = 64                     # cases per chunk (part of the run's identity)
+    scheduler = "tcp://host:8786"       # optional Dask scheduler
+
+IM levels are converted to SI once, here: ``levels_g`` multiplies by
+:data:`shipblock.units.STANDARD_GRAVITY`; ``levels`` with ``units`` goes through
+:func:`shipblock.units.acceleration_to_si` (a velocity unit ``"X/s"`` for PGV uses the length
+factor of ``"X/s^2"``). The dataset stores the levels, medians and achieved IMs in SI.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import logging
+import math
+import tomllib
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from shipblock.errors import ShipblockError
+from shipblock.fragility.batch import (
+    DEFAULT_CHUNK_SIZE,
+    prepare_record,
+    records_provenance,
+    run_batch,
+    summary_dataset,
+)
+from shipblock.fragility.design import (
+    SWEEP_PARAMETERS,
+    SYSTEM_FIELDS,
+    AnalysisDesign,
+    IntensityDesign,
+)
+from shipblock.fragility.fit import (
+    FragilityFitError,
+    bootstrap,
+    fit_cloud,
+    fit_ida,
+    fit_msa,
+    ida_capacities,
+)
+from shipblock.fragility.limit_states import (
+    EDP_VARIABLES,
+    LimitState,
+    evaluate_limit_states,
+    parse_limit_states,
+)
+from shipblock.fragility.store import ChunkStore, StoreError, open_results, write_dataset
+from shipblock.solver import DEFAULT_ATOL, DEFAULT_RTOL, DEFAULT_ZENO_OMEGA
+from shipblock.system import ShipBlockSystem
+from shipblock.units import ACCELERATION_UNITS_TO_SI, STANDARD_GRAVITY, acceleration_to_si
+
+__all__ = [
+    "SCHEMA_VERSION",
+    "Pipeline",
+    "PipelineError",
+    "fragility_variables",
+    "load_pipeline",
+    "parse_pipeline",
+    "run_pipeline",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Pipeline layout version this module reads.
+SCHEMA_VERSION = 1
+
+#: Defaults of the [fit] table.
+DEFAULT_BOOTSTRAP = 200
+DEFAULT_CONFIDENCE = 0.9
+DEFAULT_SEED = 0
+
+
+class PipelineError(ShipblockError, ValueError):
+    """A pipeline file is invalid; the message names the file and the key.
+
+    Parameters
+    ----------
+    key : str
+        Dotted key of the problem, e.g. ``"design.levels_g"`` (``""`` for the whole file).
+    problem : str
+        What is wrong.
+    source : str, optional
+        The pipeline file.
+    """
+
+    def __init__(self, key: str, problem: str, source: str = "<pipeline>"):
+        self.key = key
+        self.problem = problem
+        self.source = source
+        where = f"{source}: " + (f"[{key}] " if key else "")
+        super().__init__(where + problem)
+
+    def __reduce__(self):
+        """Keep the error picklable."""
+        return (type(self), (self.key, self.problem, self.source))
+
+
+# --------------------------------------------------------------------------------------------
+# schema
+# --------------------------------------------------------------------------------------------
+
+_NUM = (int, float)
+_SCHEMA: dict[str, dict[str, tuple]] = {
+    # section -> key -> (accepted python types, required)
+    "": {
+        "schema_version": ((int,), False),
+        "title": ((str,), False),
+        "description": ((str,), False),
+        "output": ((str,), True),
+        "records": ((dict,), True),
+        "processing": ((list,), False),
+        "system": ((dict,), True),
+        "sweep": ((dict,), False),
+        "design": ((dict,), True),
+        "limit_states": ((list,), True),
+        "fit": ((dict,), False),
+        "solver": ((dict,), False),
+        "execution": ((dict,), False),
+    },
+    "records": {
+        "catalogue": ((str,), False),
+        "ids": ((str, list), True),
+        "azimuth": (_NUM, False),
+        "horizontal": ((str,), False),
+        "response": ((str,), False),
+    },
+    "system": {
+        **{name: (_NUM, False) for name in SYSTEM_FIELDS if name != "impact_rule"},
+        "impact_rule": ((str,), False),
+        "slenderness": (_NUM, False),
+    },
+    "design": {
+        "type": ((str,), True),
+        "measure": ((str,), False),
+        "period": (_NUM, False),
+        "damping": (_NUM, False),
+        "levels": ((list,), False),
+        "levels_g": ((list,), False),
+        "units": ((str,), False),
+        "vertical": ((str,), False),
+        "vertical_levels": ((list,), False),
+        "vertical_levels_g": ((list,), False),
+        "cloud_method": ((str,), False),
+    },
+    "fit": {
+        "bootstrap": ((int,), False),
+        "confidence": (_NUM, False),
+        "seed": ((int,), False),
+        "ida_method": ((str,), False),
+    },
+    "solver": {"rtol": (_NUM, False), "atol": (_NUM, False), "zeno_omega": (_NUM, False)},
+    "execution": {"chunk_size": ((int,), False), "scheduler": ((str,), False)},
+}
+_REQUIRED_SYSTEM = ("ship_mass", "block_mass", "n_blocks", "half_height", "mu_s_ground",
+                    "mu_k_ground", "mu_s_ship", "mu_k_ship")
+_TYPE_NAMES = {int: "an integer", float: "a number", str: "a string", list: "a list",
+               dict: "a table", bool: "true/false"}
+
+
+def _type_ok(value, types) -> bool:
+    if isinstance(value, bool):
+        return bool in types
+    return isinstance(value, types)
+
+
+def _check_table(table: Mapping, section: str, source: str) -> None:
+    schema = _SCHEMA[section]
+    for key, value in table.items():
+        dotted = f"{section}.{key}" if section else key
+        if key not in schema:
+            raise PipelineError(
+                dotted, f"unknown key {key!r}; allowed keys: {', '.join(schema)}", source
+            )
+        types = schema[key][0]
+        if not _type_ok(value, types):
+            want = " or ".join(_TYPE_NAMES[t] for t in dict.fromkeys(
+                float if t in (int, float) else t for t in types))
+            raise PipelineError(dotted, f"must be {want}, got {type(value).__name__} "
+                                        f"{value!r}", source)
+    for key, (_, required) in schema.items():
+        if required and key not in table:
+            dotted = f"{section}.{key}" if section else key
+            what = "section" if _SCHEMA[""].get(key, ((),))[0] in ((dict,), (list,)) else "key"
+            raise PipelineError(dotted, f"missing required {what} {key!r}", source)
+
+
+def _numbers(values, key: str, source: str) -> tuple[float, ...]:
+    if not isinstance(values, list) or not values:
+        raise PipelineError(key, "must be a non-empty list of numbers", source)
+    for v in values:
+        if isinstance(v, bool) or not isinstance(v, _NUM) or not math.isfinite(v):
+            raise PipelineError(key, f"must hold finite numbers only, got {v!r}", source)
+    return tuple(float(v) for v in values)
+
+
+def _im_factor(measure: str, units: str, key: str, source: str) -> float:
+    """SI factor of a unit given for the IM ``measure``."""
+    u = units.strip().lower()
+    if measure == "pgv":
+        if not u.endswith("/s") or f"{u}^2" not in ACCELERATION_UNITS_TO_SI:
+            known = sorted(k[:-2] for k in ACCELERATION_UNITS_TO_SI if k.endswith("/s^2"))
+            raise PipelineError(key, f"unknown velocity unit {units!r} for PGV; use one of "
+                                     f"{', '.join(known)}", source)
+        return ACCELERATION_UNITS_TO_SI[f"{u}^2"]
+    try:
+        return float(acceleration_to_si(1.0, u))
+    except ValueError as exc:
+        raise PipelineError(key, str(exc), source) from None
+
+
+def _levels(design: Mapping, prefix: str, measure: str, source: str):
+    """SI levels from ``<prefix>levels_g`` or ``<prefix>levels`` + ``units``."""
+    kg, kl = f"{prefix}levels_g", f"{prefix}levels"
+    if kg in design and kl in design:
+        raise PipelineError(f"design.{kl}", f"give {kg!r} or {kl!r}, not both", source)
+    if kg in design:
+        if measure == "pgv":
+            raise PipelineError(f"design.{kg}", "PGV levels are velocities: use levels = [...] "
+                                                "with units = 'm/s' or 'cm/s'", source)
+        return tuple(v * STANDARD_GRAVITY for v in _numbers(design[kg], f"design.{kg}", source))
+    if kl in design:
+        if "units" not in design:
+            raise PipelineError("design.units", f"{kl!r} needs units (e.g. 'm/s^2', 'g', 'm/s')",
+                                source)
+        f = _im_factor(measure, design["units"], "design.units", source)
+        return tuple(v * f for v in _numbers(design[kl], f"design.{kl}", source))
+    return None
+
+
+# --------------------------------------------------------------------------------------------
+# parsed pipeline
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Pipeline:
+    """A parsed, validated pipeline file.
+
+    Attributes
+    ----------
+    source : str
+        The file (or ``"<pipeline>"``).
+    text : str
+        The TOML text, verbatim (stored in the result's attributes).
+    document : dict
+        The parsed TOML.
+    catalogue : pathlib.Path or None
+        Catalogue file; None for the shipped one.
+    azimuth : float or None
+        Dock transverse axis [deg clockwise from north].
+    horizontal : str or None
+        ``"H1"``/``"H2"`` when no azimuth is given.
+    response : str
+        ``"sensitivity"`` or ``"full"``.
+    chain : list of dict or None
+        Processing chain; None for the default chain.
+    design : AnalysisDesign
+        Records x levels x sweep.
+    limit_states : tuple of LimitState
+    fit : dict
+        ``bootstrap``, ``confidence``, ``seed``, ``ida_method``, ``cloud_method``.
+    solver : dict
+        ``rtol``, ``atol``, ``zeno_omega``.
+    chunk_size : int
+    scheduler : str or None
+    output : pathlib.Path
+        Output file (absolute).
+    """
+
+    source: str
+    text: str
+    document: dict
+    catalogue: Path | None
+    azimuth: float | None
+    horizontal: str | None
+    response: str
+    chain: list | None
+    design: AnalysisDesign
+    limit_states: tuple[LimitState, ...]
+    fit: dict
+    solver: dict
+    chunk_size: int
+    scheduler: str | None
+    output: Path
+
+    def identity(self) -> dict:
+        """The parts of the document that determine the results (no output path/scheduler).
+
+        Returns
+        -------
+        dict
+        """
+        doc = {k: v for k, v in self.document.items() if k not in ("output", "title",
+                                                                    "description")}
+        doc["execution"] = {"chunk_size": self.chunk_size}
+        doc["records"] = {**doc["records"], "catalogue": str(self.catalogue),
+                          "ids": list(self.design.records)}
+        return doc
+
+
+def load_pipeline(path) -> Pipeline:
+    """Read and validate a pipeline file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The TOML file.
+
+    Returns
+    -------
+    Pipeline
+
+    Raises
+    ------
+    PipelineError
+        If the file is missing, not TOML, or invalid; the message names the key.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise PipelineError("", f"cannot read the pipeline file ({exc})", str(path)) from exc
+    return parse_pipeline(text, base=path.resolve().parent, source=str(path))
+
+
+def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
+    """Parse and validate pipeline TOML text.
+
+    Parameters
+    ----------
+    text : str
+        The TOML document.
+    base : str or os.PathLike
+        Directory that relative paths (catalogue, output) are relative to.
+    source : str
+        Name used in error messages.
+
+    Returns
+    -------
+    Pipeline
+
+    Raises
+    ------
+    PipelineError
+        Naming the key: unknown key, wrong type, missing section or key, invalid value,
+        unknown record id, invalid system, limit state or design.
+    """
+    from shipblock.catalogue import load_catalogue
+
+    base = Path(base)
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise PipelineError("", f"is not valid TOML: {exc}", source) from exc
+    _check_table(doc, "", source)
+    version = doc.get("schema_version", SCHEMA_VERSION)
+    if version != SCHEMA_VERSION:
+        raise PipelineError("schema_version", f"must be {SCHEMA_VERSION}, got {version}", source)
+    for section in ("records", "system", "design", "fit", "solver", "execution"):
+        if section in doc:
+            _check_table(doc[section], section, source)
+
+    # records
+    rec = doc["records"]
+    catalogue = (base / rec["catalogue"]).resolve() if "catalogue" in rec else None
+    try:
+        entries = load_catalogue(catalogue)
+    except ShipblockError as exc:
+        raise PipelineError("records.catalogue", str(exc), source) from None
+    ids = rec["ids"]
+    if isinstance(ids, str):
+        if ids != "all":
+            raise PipelineError("records.ids", f"must be 'all' or a list of ids, got {ids!r}",
+                                source)
+        ids = list(entries)
+    if not ids or not all(isinstance(i, str) for i in ids):
+        raise PipelineError("records.ids", "must be a non-empty list of record ids (strings)",
+                            source)
+    missing = [i for i in ids if i not in entries]
+    if missing:
+        raise PipelineError("records.ids", f"not in the catalogue: {', '.join(missing)}; "
+                                           f"known: {', '.join(entries)}", source)
+    if "azimuth" in rec and "horizontal" in rec:
+        raise PipelineError("records.horizontal", "give azimuth or horizontal, not both", source)
+    horizontal = rec.get("horizontal", None if "azimuth" in rec else "H1")
+    if horizontal is not None and horizontal not in ("H1", "H2"):
+        raise PipelineError("records.horizontal", f"must be 'H1' or 'H2', got {horizontal!r}",
+                            source)
+    response = rec.get("response", "sensitivity")
+    if response not in ("sensitivity", "full"):
+        raise PipelineError("records.response", "must be 'sensitivity' or 'full'", source)
+    azimuth = float(rec["azimuth"]) if "azimuth" in rec else None
+
+    # processing
+    chain = None
+    if "processing" in doc:
+        chain = doc["processing"]
+        for k, entry in enumerate(chain):
+            if not isinstance(entry, dict) or "step" not in entry:
+                raise PipelineError(f"processing[{k}]", "must be a table with a 'step' key",
+                                    source)
+        _check_chain(chain, source)
+
+    # system
+    sys_table = dict(doc["system"])
+    for key in _REQUIRED_SYSTEM:
+        if key not in sys_table:
+            raise PipelineError(f"system.{key}", f"missing required key {key!r}", source)
+    if "slenderness" in sys_table:
+        if "half_width" in sys_table:
+            raise PipelineError("system.slenderness", "give slenderness or half_width, not both",
+                                source)
+        sys_table["half_width"] = float(sys_table.pop("slenderness")) * sys_table["half_height"]
+    elif "half_width" not in sys_table:
+        raise PipelineError("system.half_width", "missing (give half_width or slenderness)",
+                            source)
+    try:
+        system = ShipBlockSystem(**sys_table)
+    except (TypeError, ValueError) as exc:
+        raise PipelineError("system", str(exc), source) from None
+
+    # sweep
+    sweep = []
+    for name, values in doc.get("sweep", {}).items():
+        if name not in SWEEP_PARAMETERS:
+            raise PipelineError(f"sweep.{name}", f"unknown parameter {name!r}; sweepable: "
+                                                 f"{', '.join(SWEEP_PARAMETERS)}", source)
+        if not isinstance(values, list) or not values:
+            raise PipelineError(f"sweep.{name}", "must be a non-empty list of values", source)
+        for v in values:
+            if isinstance(v, bool) or not isinstance(v, _NUM):
+                raise PipelineError(f"sweep.{name}", f"must hold numbers, got {v!r}", source)
+        sweep.append((name, tuple(values)))
+
+    # design
+    d = doc["design"]
+    measure = d.get("measure", "pga")
+    if measure not in ("pga", "pgv", "sa"):
+        raise PipelineError("design.measure", f"must be 'pga', 'pgv' or 'sa', got {measure!r}",
+                            source)
+    levels = _levels(d, "", measure, source)
+    v_levels = _levels(d, "vertical_", measure, source)
+    if "units" in d and "levels" not in d and "vertical_levels" not in d:
+        raise PipelineError("design.units", "is only used with levels = [...]", source)
+    kind = d["type"]
+    intensity = IntensityDesign(
+        kind=kind,
+        measure=measure,
+        levels=levels or (),
+        period=None if "period" not in d else float(d["period"]),
+        damping=float(d.get("damping", 0.05)),
+        vertical=d.get("vertical", "same"),
+        vertical_levels=v_levels,
+    )
+    try:
+        intensity.validate()
+    except ValueError as exc:
+        key = "design.levels_g" if "levels" in str(exc) and "levels_g" in d else "design"
+        raise PipelineError(key, str(exc), source) from None
+    cloud_method = d.get("cloud_method", "probit")
+    if cloud_method not in ("probit", "regression"):
+        raise PipelineError("design.cloud_method", "must be 'probit' or 'regression'", source)
+    if "cloud_method" in d and kind != "cloud":
+        raise PipelineError("design.cloud_method", "applies only to type = 'cloud'", source)
+    design = AnalysisDesign(tuple(ids), intensity, system, tuple(sweep))
+    try:
+        design.validate()
+    except ValueError as exc:
+        raise PipelineError("sweep", str(exc), source) from None
+
+    # limit states
+    try:
+        limit_states = parse_limit_states(doc["limit_states"])
+    except ValueError as exc:
+        raise PipelineError("limit_states", str(exc), source) from None
+    if not limit_states:
+        raise PipelineError("limit_states", "define at least one [[limit_states]]", source)
+    if kind == "cloud" and cloud_method == "regression":
+        for ls in limit_states:
+            if ls.condition not in ("greater", "greater_equal") or \
+                    EDP_VARIABLES[ls.edp].kind != "float":
+                raise PipelineError("limit_states", f"limit state {ls.name!r}: the cloud "
+                                    "regression needs a threshold on a continuous EDP; use "
+                                    "cloud_method = 'probit'", source)
+
+    # fit, solver, execution
+    f = doc.get("fit", {})
+    fit = {
+        "bootstrap": f.get("bootstrap", DEFAULT_BOOTSTRAP),
+        "confidence": float(f.get("confidence", DEFAULT_CONFIDENCE)),
+        "seed": f.get("seed", DEFAULT_SEED),
+        "ida_method": f.get("ida_method", "mle"),
+        "cloud_method": cloud_method,
+    }
+    if fit["bootstrap"] < 0:
+        raise PipelineError("fit.bootstrap", "must be >= 0", source)
+    if not 0 < fit["confidence"] < 1:
+        raise PipelineError("fit.confidence", "must lie in (0, 1)", source)
+    if fit["ida_method"] not in ("mle", "moments"):
+        raise PipelineError("fit.ida_method", "must be 'mle' or 'moments'", source)
+    s = doc.get("solver", {})
+    solver = {"rtol": float(s.get("rtol", DEFAULT_RTOL)),
+              "atol": float(s.get("atol", DEFAULT_ATOL)),
+              "zeno_omega": float(s.get("zeno_omega", DEFAULT_ZENO_OMEGA))}
+    if not 0 < solver["rtol"] < 1:
+        raise PipelineError("solver.rtol", "must lie in (0, 1)", source)
+    if not solver["atol"] > 0:
+        raise PipelineError("solver.atol", "must be > 0", source)
+    if not solver["zeno_omega"] >= 0:
+        raise PipelineError("solver.zeno_omega", "must be >= 0 [rad/s]", source)
+    ex = doc.get("execution", {})
+    chunk_size = ex.get("chunk_size", DEFAULT_CHUNK_SIZE)
+    if chunk_size < 1:
+        raise PipelineError("execution.chunk_size", "must be >= 1", source)
+    return Pipeline(
+        source=source, text=text, document=doc, catalogue=catalogue, azimuth=azimuth,
+        horizontal=horizontal, response=response, chain=chain, design=design,
+        limit_states=limit_states, fit=fit, solver=solver, chunk_size=int(chunk_size),
+        scheduler=ex.get("scheduler"), output=(base / doc["output"]).resolve(),
+    )
+
+
+def _check_chain(chain, source):
+    """Validate the processing chain on a tiny synthetic stream (step names and parameters)."""
+    from obspy import Stream, Trace
+
+    from shipblock.processing import STEPS, ProcessingError, apply_chain
+
+    for k, entry in enumerate(chain):
+        if entry["step"] not in STEPS:
+            raise PipelineError(f"processing[{k}].step", f"unknown step {entry['step']!r}; "
+                                                         f"known: {', '.join(sorted(STEPS))}",
+                                source)
+    tr = Trace(np.sin(np.linspace(0, 20, 4000)))
+    tr.stats.delta = 0.005
+    try:
+        apply_chain(Stream([tr]), chain)
+    except ProcessingError as exc:
+        k = next((i for i, e in enumerate(chain) if e["step"] == exc.step), None)
+        key = "processing" if k is None else f"processing[{k}]"
+        if exc.parameter and k is not None:
+            key += f".{exc.parameter}"
+        raise PipelineError(key, str(exc), source) from None
+    except Exception:  # noqa: BLE001 - data-dependent failures surface per record
+        pass
+
+
+# --------------------------------------------------------------------------------------------
+# fragility
+# --------------------------------------------------------------------------------------------
+
+
+def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng):
+    """Fit one limit state for one parameter combination; returns a dict of results."""
+    out = {"median": np.nan, "beta": np.nan, "median_lower": np.nan, "median_upper": np.nan,
+           "beta_lower": np.nan, "beta_upper": np.nan, "fit_method": "", "fit_error": "",
+           "n_fit_records": 0, "bootstrap_failed": 0}
+    keep = w.any(axis=1) if e.ndim == 2 else w
+    out["n_fit_records"] = int(keep.sum())
+    capacity = None
+    n_boot = fit_opts["bootstrap"]
+    try:
+        if kind == "ida":
+            caps = ida_capacities(e[keep], levels, w[keep])
+            capacity = caps
+            args = {"capacities": caps.capacity, "censored_at": caps.censored_at}
+            fn, kw = fit_ida, {"method": fit_opts["ida_method"]}
+        elif kind == "msa":
+            args = {"exceeded": e[keep], "valid": w[keep]}
+            fn, kw = fit_msa, {"im_levels": levels}
+        elif fit_opts["cloud_method"] == "probit":
+            args = {"im": im[keep], "edp": e[keep].astype(float)}
+            fn, kw = fit_cloud, {"capacity": 0.5, "method": "probit"}
+        else:
+            args = {"im": im[keep], "edp": np.abs(edp[keep])}
+            fn, kw = fit_cloud, {"capacity": ls.threshold, "method": "regression"}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            fit = fn(**args, **kw)
+        out.update(median=fit.median, beta=fit.beta, fit_method=fit.method)
+        if n_boot:
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", RuntimeWarning)
+                    b = bootstrap(fn, args, n_boot=n_boot, confidence=fit_opts["confidence"],
+                                  seed=rng, **kw)
+                out.update(median_lower=b.fit.median_ci[0], median_upper=b.fit.median_ci[1],
+                           beta_lower=b.fit.beta_ci[0], beta_upper=b.fit.beta_ci[1],
+                           bootstrap_failed=b.n_failed)
+            except ValueError as exc:
+                out["fit_error"] = f"bootstrap: {exc}"
+    except (FragilityFitError, ValueError) as exc:
+        out["fit_error"] = f"{type(exc).__name__}: {exc}"
+    return out, capacity
+
+
+def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fit_opts) -> dict:
+    """Exceedance, fitted median/beta and bootstrap bounds of every limit state.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Per-run summaries on ``design.dims`` (from
+        :func:`~shipblock.fragility.batch.summary_dataset`).
+    design : AnalysisDesign
+        The grid.
+    limit_states : sequence of LimitState
+        The limit states (the ``limit_state`` dimension).
+    fit_opts : dict
+        ``bootstrap`` (resamples), ``confidence``, ``seed``, ``ida_method``, ``cloud_method``.
+
+    Returns
+    -------
+    dict
+        Name -> :class:`xarray.DataArray` with ``units`` and ``long_name``: ``exceeded`` and
+        ``valid`` on ``(limit_state, *design.dims)``; ``median``, ``beta``, their bounds,
+        ``fit_method``, ``fit_error``, ``n_fit_records``, ``bootstrap_failed`` on
+        ``(limit_state, *sweep)``; ``ida_capacity`` on ``(limit_state, record, *sweep)`` for
+        IDA. Bootstrap resampling of combination ``c`` of limit state ``i`` is seeded with
+        ``[seed, i, c]``.
+    """
+    intensity = design.intensity
+    kind = intensity.kind
+    levels = np.asarray(intensity.levels, dtype=float)
+    ex = evaluate_limit_states(limit_states, ds)
+    names = [ls.name for ls in limit_states]
+    sweep_dims = design.sweep_names
+    sweep_shape = design.sweep_shape
+    n_ls = len(limit_states)
+    fields = {k: np.full((n_ls, *sweep_shape), np.nan) for k in (
+        "median", "beta", "median_lower", "median_upper", "beta_lower", "beta_upper")}
+    fields["n_fit_records"] = np.zeros((n_ls, *sweep_shape), dtype=np.int64)
+    fields["bootstrap_failed"] = np.zeros((n_ls, *sweep_shape), dtype=np.int64)
+    fields["fit_method"] = np.full((n_ls, *sweep_shape), "", dtype=object)
+    fields["fit_error"] = np.full((n_ls, *sweep_shape), "", dtype=object)
+    capacity = np.full((n_ls, len(design.records), *sweep_shape), np.nan)
+    im = ds["achieved_im"].values if not intensity.scaled else None
+    for i, ls in enumerate(limit_states):
+        e_all = ex[ls.name].exceeded.transpose(*design.dims).values
+        w_all = ex[ls.name].valid.transpose(*design.dims).values
+        edp_all = ds[ls.edp].transpose(*design.dims).values
+        lead = e_all.ndim - len(sweep_shape)
+        for c, combo in enumerate(itertools.product(*(range(n) for n in sweep_shape))):
+            sel = (slice(None),) * lead + combo
+            rng = np.random.default_rng([int(fit_opts["seed"]), i, c])
+            res, caps = _fit_one(kind, e_all[sel], w_all[sel], levels, im, edp_all[sel], ls,
+                                 fit_opts, rng)
+            for k, v in res.items():
+                fields[k][(i, *combo)] = v
+            if caps is not None:
+                keep = w_all[sel].any(axis=1)
+                col = np.full(len(design.records), np.nan)
+                col[keep] = caps.capacity
+                capacity[(i, slice(None), *combo)] = col
+    im_units = intensity.units
+    dims_fit = ("limit_state", *sweep_dims)
+    info = {
+        "median": (im_units,
+                   f"median capacity theta of the fragility curve ({intensity.long_name})"),
+        "beta": ("1", "logarithmic standard deviation beta of the fragility curve"),
+        "median_lower": (im_units, "lower bootstrap confidence bound of the median"),
+        "median_upper": (im_units, "upper bootstrap confidence bound of the median"),
+        "beta_lower": ("1", "lower bootstrap confidence bound of beta"),
+        "beta_upper": ("1", "upper bootstrap confidence bound of beta"),
+        "fit_method": ("1", "fitting method (shipblock.fragility.fit)"),
+        "fit_error": ("1", "why the fit (or its bootstrap) failed (empty if it did not)"),
+        "n_fit_records": ("1", "number of records with at least one valid run"),
+        "bootstrap_failed": ("1", "bootstrap resamples that could not be fitted"),
+    }
+    out = {}
+    for k, (units, long_name) in info.items():
+        attrs = {"units": units, "long_name": long_name}
+        if k.endswith(("_lower", "_upper")):
+            attrs["confidence"] = fit_opts["confidence"]
+            attrs["n_bootstrap"] = int(fit_opts["bootstrap"])
+        out[k] = xr.DataArray(fields[k], dims=dims_fit, attrs=attrs)
+    dims_run = ("limit_state", *design.dims)
+    out["exceeded"] = xr.DataArray(
+        np.stack([ex[n].exceeded.transpose(*design.dims).values for n in names]), dims=dims_run,
+        attrs={"units": "1", "long_name": "limit state exceeded by the run "
+                                          "(collapse exceeds every response limit state)"})
+    out["valid"] = xr.DataArray(
+        np.stack([ex[n].valid.transpose(*design.dims).values for n in names]), dims=dims_run,
+        attrs={"units": "1", "long_name": "run produced a usable result for the limit state"})
+    if kind == "ida":
+        out["ida_capacity"] = xr.DataArray(
+            capacity, dims=("limit_state", "record", *sweep_dims),
+            attrs={"units": im_units, "long_name": "IDA capacity: first IM level exceeding the "
+                   "limit state (inf: never; NaN: no valid run)"})
+    return out
+
+
+def _limit_state_coords(limit_states) -> dict:
+    return {
+        "limit_state": ("limit_state", np.array([ls.name for ls in limit_states], dtype=object),
+                        {"units": "1", "long_name": "limit state"}),
+        "limit_state_edp": ("limit_state", np.array([ls.edp for ls in limit_states],
+                                                    dtype=object),
+                            {"units": "1", "long_name": "EDP of the limit state"}),
+        "limit_state_condition": (
+            "limit_state", np.array([ls.condition for ls in limit_states], dtype=object),
+            {"units": "1", "long_name": "condition of the limit state"}),
+        "limit_state_threshold": (
+            "limit_state",
+            np.array([np.nan if ls.threshold is None else float(ls.threshold)
+                      for ls in limit_states]),
+            {"units": "EDP units (see limit_state_edp)",
+             "long_name": "threshold of the limit state (NaN for 'nonzero')"}),
+    }
+
+
+# --------------------------------------------------------------------------------------------
+# run
+# --------------------------------------------------------------------------------------------
+
+
+def _fingerprint(pipe: Pipeline, records) -> str:
+    from shipblock import __version__
+
+    h = hashlib.sha256(json.dumps(pipe.identity(), sort_keys=True, default=str).encode())
+    h.update(__version__.encode())
+    for r in records:
+        h.update(r.digest().encode())
+    return h.hexdigest()
+
+
+def _loader(entry, pipe: Pipeline):
+    def load():
+        kwargs = {"response": pipe.response}
+        if pipe.azimuth is not None:
+            return entry.read(azimuth=pipe.azimuth, **kwargs)
+        return entry.read(horizontal=pipe.horizontal, **kwargs)
+
+    return load
+
+
+def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool = True
+                 ) -> xr.Dataset:
+    """Run a pipeline file end to end and return the dataset it wrote.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The pipeline TOML file.
+    output : str or os.PathLike, optional
+        Output NetCDF file; overrides the file's ``output``. Finished chunks are kept in
+        ``<output>.partial/`` until the final file is written; rerunning resumes from them.
+    client : distributed.Client, optional
+        Run the chunks as tasks on this Dask client.
+    scheduler : str, optional
+        Address of a Dask scheduler (``"tcp://host:port"``) to connect to (overrides the file's
+        ``execution.scheduler``); ignored when ``client`` is given.
+    progress : bool
+        Show a progress bar (runs done, rate, time left).
+
+    Returns
+    -------
+    xarray.Dataset
+        The results, as read back from the output file.
+
+    Raises
+    ------
+    PipelineError
+        If the pipeline is invalid, or the partial directory belongs to another run.
+    """
+    from shipblock import __version__
+    from shipblock.catalogue import load_catalogue
+    from shipblock.processing import DEFAULT_CHAIN
+
+    pipe = load_pipeline(path)
+    out_path = Path(output).resolve() if output is not None else pipe.output
+    design = pipe.design
+    entries = load_catalogue(pipe.catalogue)
+    records = [
+        prepare_record(rid, _loader(entries[rid], pipe), pipe.chain, design.intensity)
+        for rid in design.records
+    ]
+    fingerprint = _fingerprint(pipe, records)
+    store = ChunkStore(out_path.with_name(out_path.name + ".partial"), fingerprint)
+    try:
+        store.open({"n_cases": design.n_cases, "chunk_size": pipe.chunk_size,
+                    "pipeline": pipe.source})
+    except StoreError as exc:
+        raise PipelineError("output", str(exc), pipe.source) from None
+    own_client = None
+    scheduler = scheduler or pipe.scheduler
+    if client is None and scheduler:
+        from distributed import Client
+
+        client = own_client = Client(scheduler)
+    try:
+        results = run_batch(design, records, store, chunk_size=pipe.chunk_size, client=client,
+                            progress=progress, solver_options=pipe.solver)
+    finally:
+        if own_client is not None:
+            own_client.close()
+    ds = summary_dataset(design, records, results)
+    ds = ds.assign_coords({k: xr.Variable(*v) for k, v in _limit_state_coords(
+        pipe.limit_states).items()})
+    ds = ds.assign(fragility_variables(ds, design, pipe.limit_states, pipe.fit))
+    chain = [dict(e) for e in (DEFAULT_CHAIN if pipe.chain is None else pipe.chain)]
+    intensity = design.intensity
+    ds.attrs = {
+        "title": pipe.document.get("title", "shipblock fragility study"),
+        "shipblock_version": __version__,
+        "created": datetime.now(UTC).isoformat(timespec="seconds"),
+        "pipeline": pipe.text,
+        "pipeline_source": str(pipe.source),
+        "pipeline_fingerprint": fingerprint,
+        "design_type": intensity.kind,
+        "im_measure": intensity.measure,
+        "im_units": intensity.units,
+        "im_long_name": intensity.long_name,
+        "im_damping": intensity.damping,
+        "vertical_mode": intensity.vertical,
+        "component": (f"azimuth {pipe.azimuth:g} deg" if pipe.azimuth is not None
+                      else str(pipe.horizontal)),
+        "catalogue": str(pipe.catalogue or "shipped records/catalogue.toml"),
+        "system": json.dumps(design.system.to_dict(), sort_keys=True),
+        "sweep": json.dumps({k: list(v) for k, v in design.sweep}),
+        "processing_chain": json.dumps(chain, sort_keys=True),
+        "records_provenance": records_provenance(records),
+        "limit_states": json.dumps([ls.to_dict() for ls in pipe.limit_states]),
+        "fit_options": json.dumps(pipe.fit, sort_keys=True),
+        "solver_options": json.dumps(pipe.solver, sort_keys=True),
+    }
+    if intensity.period is not None:
+        ds.attrs["im_period"] = intensity.period
+    write_dataset(ds, out_path)
+    store.remove()
+    logger.info("wrote %s", out_path)
+    return open_results(out_path)

@@ -1,0 +1,316 @@
+"""Storage of batch results: per-chunk partial files and the final NetCDF dataset.
+
+Two layers, both crash-safe:
+
+* :class:`ChunkStore` keeps one small ``.npz`` file per finished chunk in a directory
+  (``<output>.partial/``). Each file is written to a temporary name in the same directory and
+  moved into place with :func:`os.replace`, which is atomic on POSIX and Windows, so a file with
+  the final name is always complete. A ``manifest.json`` holds the fingerprint of the run (the
+  pipeline, the shipblock version and the prepared records); a rerun with another fingerprint
+  refuses to mix results.
+* :func:`write_dataset` writes the final :class:`xarray.Dataset` to NetCDF-4 (engine
+  ``netcdf4``, zlib compression of every numeric variable) through a temporary file and
+  :func:`os.replace`; :func:`open_results` reads it back.
+
+Every variable and coordinate of a result dataset carries ``units`` and ``long_name``;
+:data:`RUN_VARIABLES` lists those of the per-run summaries.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from shipblock.errors import ShipblockError
+from shipblock.fragility.limit_states import EDP_VARIABLES
+from shipblock.solver import MODE_TIME_FIELDS, SUMMARY_FIELDS
+
+__all__ = [
+    "COMPRESSION_LEVEL",
+    "RUN_VARIABLES",
+    "ChunkStore",
+    "StoreError",
+    "check_metadata",
+    "open_results",
+    "write_dataset",
+]
+
+#: zlib compression level of numeric NetCDF variables [-] (1 fastest ... 9 smallest).
+COMPRESSION_LEVEL = 4
+
+_MANIFEST = "manifest.json"
+_CHUNK_PREFIX = "chunk-"
+
+
+class StoreError(ShipblockError, ValueError):
+    """A partial-results directory or result file cannot be used."""
+
+
+def _run_variables() -> dict[str, tuple[str, str]]:
+    extra = {
+        "peak_rotation_time": ("s", "time of the peak absolute block rotation"),
+        "failure_time": ("s", "time of separation or overturning (NaN if none)"),
+        "end_time": ("s", "time the simulation ended"),
+        "n_events": ("1", "number of mode transitions and impacts"),
+        "input_work": ("J", "work done by the ground motion"),
+        "friction_dissipation": ("J", "energy dissipated by friction"),
+        "impact_loss": ("J", "kinetic energy lost in rocking impacts"),
+        "n_mode_fallbacks": ("1", "number of mode selections resolved by the fallback rule"),
+        "final_energy": ("J", "kinetic plus potential energy at the end of the run"),
+    }
+    out = {}
+    for name in [*SUMMARY_FIELDS, "peak_rotation_ratio", *MODE_TIME_FIELDS]:
+        if name in EDP_VARIABLES:
+            info = EDP_VARIABLES[name]
+            out[name] = (info.units, info.long_name)
+        elif name in extra:
+            out[name] = extra[name]
+        elif name.startswith("time_in_mode_"):
+            out[name] = ("s", f"time spent in mode {name.rsplit('_', 1)[1]}")
+        else:  # a summary field added to the solver later
+            out[name] = ("1", name.replace("_", " "))
+    return out
+
+
+#: Per-run summary variables of a result dataset: name -> (units, long name). All are stored as
+#: float64 with NaN for runs that produced no result (record or solver error); ``failure`` is
+#: the code 0 none, 1 separation, 2 overturning (a solver error, code 3, is stored as NaN and
+#: described in ``run_error``).
+RUN_VARIABLES: dict[str, tuple[str, str]] = _run_variables()
+
+
+# --------------------------------------------------------------------------------------------
+# partial results
+# --------------------------------------------------------------------------------------------
+
+
+def _atomic_write(path: Path, write) -> None:
+    """Write ``path`` through a temporary file in the same directory and ``os.replace``."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            write(fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+class ChunkStore:
+    """One ``.npz`` file per finished chunk, in a directory.
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        The partial-results directory (created when needed).
+    fingerprint : str
+        Identity of the run; chunks of a run with another fingerprint are never used.
+
+    Raises
+    ------
+    StoreError
+        From :meth:`open` if the directory holds chunks of another run.
+    """
+
+    def __init__(self, directory, fingerprint: str):
+        self.directory = Path(directory)
+        self.fingerprint = str(fingerprint)
+
+    def open(self, info: dict | None = None) -> ChunkStore:
+        """Create the directory and its manifest, or check the manifest of an existing one.
+
+        Parameters
+        ----------
+        info : dict, optional
+            Extra JSON-serialisable facts written to a new manifest (case count, chunk size).
+
+        Returns
+        -------
+        ChunkStore
+            ``self``.
+
+        Raises
+        ------
+        StoreError
+            If an existing manifest has another fingerprint or cannot be read.
+        """
+        self.directory.mkdir(parents=True, exist_ok=True)
+        manifest = self.directory / _MANIFEST
+        if manifest.exists():
+            try:
+                found = json.loads(manifest.read_text())["fingerprint"]
+            except (OSError, ValueError, KeyError) as exc:
+                raise StoreError(f"{manifest}: unreadable manifest ({exc})") from exc
+            if found != self.fingerprint:
+                raise StoreError(
+                    f"{self.directory} holds partial results of a different run (the pipeline, "
+                    "the records or the shipblock version changed); delete the directory to "
+                    "start again"
+                )
+            return self
+        text = json.dumps({"fingerprint": self.fingerprint, **(info or {})}, indent=1)
+        _atomic_write(manifest, lambda fh: fh.write(text.encode()))
+        return self
+
+    def _path(self, chunk_id: int) -> Path:
+        return self.directory / f"{_CHUNK_PREFIX}{int(chunk_id):06d}.npz"
+
+    def completed(self) -> set[int]:
+        """Ids of the chunks whose files exist.
+
+        Returns
+        -------
+        set of int
+        """
+        if not self.directory.is_dir():
+            return set()
+        out = set()
+        for p in self.directory.glob(f"{_CHUNK_PREFIX}*.npz"):
+            with contextlib.suppress(ValueError):
+                out.add(int(p.stem[len(_CHUNK_PREFIX):]))
+        return out
+
+    def write(self, chunk_id: int, cases, arrays: dict) -> None:
+        """Write one finished chunk atomically.
+
+        Parameters
+        ----------
+        chunk_id : int
+            The chunk number.
+        cases : array_like of int
+            Case numbers of the chunk.
+        arrays : dict of numpy.ndarray
+            Per-case results (float arrays of the length of ``cases``) and optional string
+            arrays (``run_error``).
+        """
+        payload = {"cases": np.asarray(cases, dtype=np.int64)}
+        for name, value in arrays.items():
+            payload[f"v_{name}"] = np.asarray(value)
+        _atomic_write(self._path(chunk_id), lambda fh: np.savez(fh, **payload))
+
+    def read(self, chunk_id: int) -> tuple[np.ndarray, dict]:
+        """Read a finished chunk.
+
+        Parameters
+        ----------
+        chunk_id : int
+            The chunk number.
+
+        Returns
+        -------
+        cases : numpy.ndarray of int
+        arrays : dict of numpy.ndarray
+
+        Raises
+        ------
+        StoreError
+            If the file is unreadable (it is then best deleted and recomputed).
+        """
+        path = self._path(chunk_id)
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                cases = data["cases"]
+                arrays = {k[2:]: data[k] for k in data.files if k.startswith("v_")}
+        except (OSError, ValueError, KeyError) as exc:
+            raise StoreError(f"{path}: unreadable chunk file ({exc})") from exc
+        return cases, arrays
+
+    def discard(self, chunk_id: int) -> None:
+        """Delete one chunk file (e.g. an unreadable one)."""
+        with contextlib.suppress(FileNotFoundError):
+            self._path(chunk_id).unlink()
+
+    def remove(self) -> None:
+        """Delete the whole directory."""
+        shutil.rmtree(self.directory, ignore_errors=True)
+
+
+# --------------------------------------------------------------------------------------------
+# final dataset
+# --------------------------------------------------------------------------------------------
+
+
+def check_metadata(ds: xr.Dataset) -> None:
+    """Check that every variable and coordinate has ``units`` and ``long_name``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+
+    Raises
+    ------
+    StoreError
+        Naming the first variable that lacks one.
+    """
+    for name, var in ds.variables.items():
+        for key in ("units", "long_name"):
+            if key not in var.attrs:
+                raise StoreError(f"variable {name!r} has no {key!r} attribute")
+
+
+def _encoding(ds: xr.Dataset) -> dict:
+    enc = {}
+    for name, var in ds.variables.items():
+        if var.dtype.kind in "fiub" and var.ndim > 0:
+            enc[name] = {"zlib": True, "complevel": COMPRESSION_LEVEL}
+    return enc
+
+
+def write_dataset(ds: xr.Dataset, path) -> Path:
+    """Write a result dataset to NetCDF-4 atomically.
+
+    The file is written with the ``netcdf4`` engine and zlib compression of every numeric
+    variable to a temporary file next to ``path``, then renamed over ``path``: a reader (or a
+    crash) never sees a half-written file.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The dataset; must pass :func:`check_metadata`.
+    path : str or os.PathLike
+        Destination (parent directories are created).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    check_metadata(ds)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=_encoding(ds))
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def open_results(path) -> xr.Dataset:
+    """Read a result dataset fully into memory (the file is closed on return).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A file written by :func:`write_dataset`.
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        return ds.load()

@@ -1,0 +1,345 @@
+"""End-to-end tests of pipeline files: validation, results, resume after SIGKILL, Dask.
+
+Records are short synthetic MiniSEED files (6 s at 100 Hz, see ``test_batch.make_catalogue``)
+so that the whole module runs in seconds once the solver is compiled.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import shipblock
+from shipblock import simulate
+from shipblock.catalogue import load_catalogue
+from shipblock.fragility.pipeline import PipelineError, load_pipeline, run_pipeline
+from shipblock.units import STANDARD_GRAVITY as G
+
+from .test_batch import make_catalogue
+
+PIPELINE = """
+schema_version = 1
+title = "test"
+output = "out/result.nc"
+
+[records]
+catalogue = "records/catalogue.toml"
+ids = {ids}
+horizontal = "H1"
+
+[[processing]]
+step = "demean"
+[[processing]]
+step = "taper"
+max_percentage = 0.05
+
+[system]
+ship_mass = 5.0e6
+block_mass = 1200.0
+n_blocks = 150
+half_width = 0.3
+half_height = 0.6
+mu_s_ground = 0.6
+mu_k_ground = 0.55
+mu_s_ship = 0.35
+mu_k_ship = 0.30
+{sweep}
+[design]
+type = "{kind}"
+{levels}
+
+[[limit_states]]
+name = "ship_slip"
+edp = "peak_ship_slip"
+threshold = 0.005
+
+[[limit_states]]
+name = "any_failure"
+edp = "failure"
+condition = "nonzero"
+
+[fit]
+bootstrap = 20
+seed = 3
+
+[execution]
+chunk_size = {chunk_size}
+"""
+
+
+def write_pipeline(tmp_path, *, ids='"all"', kind="ida", sweep="", chunk_size=4,
+                   levels='levels_g = [0.2, 0.4, 0.5, 0.6, 0.8]', n_records=3, bad=False,
+                   name="p.toml") -> Path:
+    if not (tmp_path / "records" / "catalogue.toml").exists():
+        make_catalogue(tmp_path / "records", n_records=n_records, bad=bad)
+    text = PIPELINE.format(ids=ids, kind=kind, sweep=sweep, chunk_size=chunk_size,
+                           levels=levels)
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def assert_same_results(a: xr.Dataset, b: xr.Dataset):
+    """Equal data and coordinates (NaN == NaN) and equal attributes except the time stamp."""
+    xr.testing.assert_identical(a.drop_attrs(deep=False), b.drop_attrs(deep=False))
+    strip = {k: v for k, v in a.attrs.items() if k != "created"}
+    assert strip == {k: v for k, v in b.attrs.items() if k != "created"}
+
+
+@pytest.fixture(scope="module")
+def ida_run(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("ida")
+    path = write_pipeline(tmp)
+    ds = run_pipeline(path, progress=False)
+    return tmp, path, ds
+
+
+# -------------------------------------------------------------------------------------------
+# results
+# -------------------------------------------------------------------------------------------
+
+
+def test_ida_dataset_layout_and_fits(ida_run):
+    tmp, path, ds = ida_run
+    assert (tmp / "out" / "result.nc").is_file()
+    assert not (tmp / "out" / "result.nc.partial").exists()  # removed after the final write
+    assert ds.sizes == {"record": 3, "im_level": 5, "limit_state": 2}
+    assert list(ds["record"].values) == ["syn/S0", "syn/S1", "syn/S2"]
+    np.testing.assert_allclose(ds["im_level"], np.array([0.2, 0.4, 0.5, 0.6, 0.8]) * G)
+    assert ds["peak_ship_slip"].dims == ("record", "im_level")
+    assert ds["exceeded"].dims == ("limit_state", "record", "im_level")
+    # achieved IM equals the target level for every record
+    np.testing.assert_allclose(ds["achieved_im"], np.broadcast_to(ds["im_level"], (3, 5)),
+                               rtol=1e-9)
+    # fitted median per limit state, in m/s^2, inside the analysed range
+    median = ds["median"].sel(limit_state="ship_slip")
+    assert ds["median"].attrs["units"] == "m/s^2"
+    assert 0.2 * G < float(median) < 0.8 * G
+    assert float(ds["beta"].sel(limit_state="ship_slip")) > 0
+    # exceedance is consistent with the EDP and threshold
+    expect = (ds["peak_ship_slip"] > 0.005) | (ds["failure"] != 0)
+    assert (ds["exceeded"].sel(limit_state="ship_slip") == expect).all()
+    # provenance
+    assert ds.attrs["pipeline"] == path.read_text()
+    assert ds.attrs["shipblock_version"] == shipblock.__version__
+    assert '"step": "taper"' in ds.attrs["processing_chain"]
+    assert "syn/S1" in ds.attrs["records_provenance"]
+    assert '"ship_mass": 5000000.0' in ds.attrs["system"]
+
+
+def test_runs_equal_single_simulate(ida_run):
+    tmp, path, ds = ida_run
+    pipe = load_pipeline(path)
+    entry = load_catalogue(pipe.catalogue)["syn/S1"]
+    from shipblock.processing import process_motion
+
+    gm = process_motion(entry.read(horizontal="H1"), pipe.chain)
+    for j in (1, 3):
+        f = float(ds["scale_factor"].isel(record=1, im_level=j))
+        fv = float(ds["vertical_scale_factor"].isel(record=1, im_level=j))
+        assert fv == f
+        res = simulate(pipe.design.system, f * gm.horizontal, fv * gm.vertical, gm.dt)
+        for name in ("peak_ship_slip", "peak_block_slip", "residual_ship_slip", "n_events",
+                     "input_work", "time_in_mode_1"):
+            assert float(ds[name].isel(record=1, im_level=j)) == float(res.summary[name])
+
+
+def test_netcdf_round_trip_units_and_compression(ida_run):
+    tmp, path, ds = ida_run
+    with xr.open_dataset(tmp / "out" / "result.nc") as plain:
+        plain = plain.load()
+        for name, var in plain.variables.items():
+            assert "units" in var.attrs and "long_name" in var.attrs, name
+            if var.dtype.kind == "f" and var.ndim:
+                assert var.encoding.get("zlib"), name
+        xr.testing.assert_identical(plain, ds)
+        assert plain["exceeded"].dtype == bool
+    assert plain["median"].sel(limit_state="ship_slip").size == 1
+
+
+def test_output_override_and_rerun_gives_same_result(ida_run, tmp_path):
+    tmp, path, ds = ida_run
+    again = run_pipeline(path, output=tmp_path / "other.nc", progress=False)
+    assert (tmp_path / "other.nc").is_file()
+    assert_same_results(ds, again)
+
+
+def test_sweep_msa_and_error_record(tmp_path):
+    path = write_pipeline(
+        tmp_path, kind="msa", bad=True, chunk_size=7,
+        sweep='[sweep]\nmu_ship = [0.3, 0.45]\nslenderness = [0.4, 0.6]\n',
+    )
+    ds = run_pipeline(path, progress=False)
+    assert ds["peak_ship_slip"].dims == ("record", "im_level", "mu_ship", "slenderness")
+    assert ds["median"].dims == ("limit_state", "mu_ship", "slenderness")
+    assert ds["mu_ship"].attrs["units"] == "1"
+    assert "unknown format" in ds["record_error"].sel(record="syn/BAD").item()
+    assert ds["peak_ship_slip"].sel(record="syn/BAD").isnull().all()
+    assert not ds["valid"].sel(record="syn/BAD").any()
+    assert ds["peak_ship_slip"].sel(record="syn/S0").notnull().all()
+    # lower ship friction slips at least as much
+    slip = ds["peak_ship_slip"].sel(record="syn/S0", slenderness=0.4)
+    assert (slip.sel(mu_ship=0.3) >= slip.sel(mu_ship=0.45)).all()
+    assert set(ds["fit_method"].sel(limit_state="ship_slip").values.ravel()) <= {"mle", ""}
+
+
+def test_cloud_design(tmp_path):
+    path = write_pipeline(tmp_path, kind="cloud", levels="", n_records=3)
+    ds = run_pipeline(path, progress=False)
+    assert "im_level" not in ds.dims
+    assert ds["peak_ship_slip"].dims == ("record",)
+    np.testing.assert_array_equal(ds["scale_factor"], 1.0)
+    np.testing.assert_allclose(ds["achieved_im"], ds["record_im"])
+
+
+# -------------------------------------------------------------------------------------------
+# invalid pipelines
+# -------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("edit", "key"),
+    [
+        (lambda t: t.replace('title = "test"', 'title = "test"\ncolour = "red"'), "colour"),
+        (lambda t: t.replace('type = "ida"', 'type = "ida"\nlevelz = [1]'), "design.levelz"),
+        (lambda t: t.replace("levels_g = [0.2, 0.4, 0.5, 0.6, 0.8]", 'levels_g = "0.1"'),
+         "design.levels_g"),
+        (lambda t: t.replace("levels_g = [0.2, 0.4, 0.5, 0.6, 0.8]", "levels_g = [0.5, 0.1]"),
+         "design.levels_g"),
+        (lambda t: t.replace("levels_g = [0.2, 0.4, 0.5, 0.6, 0.8]", "levels = [1.0, 2.0]"),
+         "design.units"),
+        (lambda t: t.replace("n_blocks = 150", 'n_blocks = "many"'), "system.n_blocks"),
+        (lambda t: t.replace("ship_mass = 5.0e6\n", ""), "system.ship_mass"),
+        (lambda t: t.replace('ids = "all"', 'ids = ["syn/S0", "nope"]'), "records.ids"),
+        (lambda t: t.replace('step = "demean"', 'step = "demeen"'), "processing[0].step"),
+        (lambda t: t.replace("max_percentage = 0.05", "max_pct = 0.05"),
+         "processing[1].max_pct"),
+        (lambda t: t.replace('edp = "peak_ship_slip"', 'edp = "ship_slip"'), "limit_states"),
+        (lambda t: t.replace("[fit]", "[sweep]\nfriction = [0.1]\n[fit]"), "sweep.friction"),
+        (lambda t: t.replace("chunk_size = 4", "chunk_size = 0"), "execution.chunk_size"),
+        (lambda t: t[: t.index("[design]")] + t[t.index("[[limit_states]]"):], "design"),
+    ],
+)
+def test_invalid_pipelines_name_the_key(tmp_path, edit, key):
+    path = write_pipeline(tmp_path)
+    path.write_text(edit(path.read_text()))
+    with pytest.raises(PipelineError) as info:
+        load_pipeline(path)
+    assert f"[{key}]" in str(info.value)
+    assert info.value.key == key
+    assert isinstance(info.value, ValueError) and isinstance(info.value, shipblock.ShipblockError)
+
+
+def test_missing_section_and_bad_toml(tmp_path):
+    path = write_pipeline(tmp_path)
+    text = path.read_text()
+    path.write_text(text.replace("[records]", "[recordz]"))
+    with pytest.raises(PipelineError, match=r"\[recordz\] unknown key"):
+        load_pipeline(path)
+    path.write_text(text[: text.index("[records]")] + text[text.index("[[processing]]"):])
+    with pytest.raises(PipelineError, match=r"\[records\] missing required section"):
+        load_pipeline(path)
+    path.write_text("this is = = not toml")
+    with pytest.raises(PipelineError, match="not valid TOML"):
+        load_pipeline(path)
+
+
+def test_shipped_pipelines_are_valid():
+    root = Path(__file__).resolve().parent.parent / "pipelines"
+    for name in ("demo", "napa_ida", "sensitivity"):
+        pipe = load_pipeline(root / f"{name}.toml")
+        assert len(pipe.design.records) == 6
+        assert len(pipe.limit_states) >= 3
+    sens = load_pipeline(root / "sensitivity.toml")
+    assert sens.design.dims == ("record", "im_level", "mu_ground", "slenderness")
+    assert "any_failure" in [ls.name for ls in load_pipeline(root / "napa_ida.toml").limit_states]
+    demo = load_pipeline(root / "demo.toml")
+    assert len(demo.design.intensity.levels) == 8
+
+
+# -------------------------------------------------------------------------------------------
+# crash safety: SIGKILL mid-run, resume, same result
+# -------------------------------------------------------------------------------------------
+
+_SLOW_RUN = textwrap.dedent(
+    """
+    import sys, time
+    from shipblock.fragility import batch
+    real = batch.run_chunk
+    def slow(*args, **kwargs):
+        time.sleep(0.4)   # make chunks slow enough to be killed mid-run
+        return real(*args, **kwargs)
+    batch.run_chunk = slow
+    from shipblock.fragility.pipeline import run_pipeline
+    run_pipeline(sys.argv[1], output=sys.argv[2], progress=False)
+    """
+)
+
+
+def test_resume_after_sigkill_gives_same_result(tmp_path, monkeypatch):
+    path = write_pipeline(tmp_path, chunk_size=1)  # 15 chunks of one run
+    reference = run_pipeline(path, output=tmp_path / "reference.nc", progress=False)
+
+    out = tmp_path / "killed.nc"
+    partial = tmp_path / "killed.nc.partial"
+    proc = subprocess.Popen([sys.executable, "-c", _SLOW_RUN, str(path), str(out)])
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            if partial.is_dir() and len(list(partial.glob("chunk-*.npz"))) >= 2:
+                break
+            if proc.poll() is not None:
+                pytest.fail("the run ended before it could be killed")
+            time.sleep(0.02)
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == -signal.SIGKILL
+    assert not out.exists()
+    done = len(list(partial.glob("chunk-*.npz")))
+    assert 2 <= done < 15
+
+    from shipblock.fragility import batch
+
+    calls = []
+    real = batch.run_chunk
+    monkeypatch.setattr(batch, "run_chunk", lambda *a, **k: (calls.append(1), real(*a, **k))[1])
+    resumed = run_pipeline(path, output=out, progress=False)
+    assert len(calls) == 15 - done  # finished chunks were not recomputed
+    assert_same_results(reference, resumed)
+    assert not partial.exists()
+
+
+def test_partial_of_another_run_is_refused(tmp_path):
+    path = write_pipeline(tmp_path)
+    partial = tmp_path / "x.nc.partial"
+    partial.mkdir()
+    (partial / "manifest.json").write_text('{"fingerprint": "something else"}')
+    with pytest.raises(PipelineError, match="different run"):
+        run_pipeline(path, output=tmp_path / "x.nc", progress=False)
+
+
+# -------------------------------------------------------------------------------------------
+# Dask
+# -------------------------------------------------------------------------------------------
+
+
+def test_dask_equals_local(ida_run, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    tmp, path, local = ida_run
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        remote = run_pipeline(path, output=tmp_path / "dask.nc", client=client, progress=False)
+    assert_same_results(local, remote)

@@ -1,0 +1,97 @@
+"""Tests of the partial-chunk store and the atomic NetCDF writer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from shipblock.fragility.store import (
+    RUN_VARIABLES,
+    ChunkStore,
+    StoreError,
+    check_metadata,
+    open_results,
+    write_dataset,
+)
+from shipblock.solver import MODE_TIME_FIELDS, SUMMARY_FIELDS
+
+
+def test_every_summary_field_has_units_and_long_name():
+    for name in [*SUMMARY_FIELDS, *MODE_TIME_FIELDS, "peak_rotation_ratio"]:
+        units, long_name = RUN_VARIABLES[name]
+        assert units and long_name
+    assert RUN_VARIABLES["peak_ship_slip"][0] == "m"
+    assert RUN_VARIABLES["time_in_mode_3"][0] == "s"
+
+
+def test_chunk_store_round_trip_and_fingerprint(tmp_path):
+    store = ChunkStore(tmp_path / "p", "abc").open({"n_cases": 10})
+    assert store.completed() == set()
+    arrays = {"peak_ship_slip": np.array([0.1, np.nan, 0.3]),
+              "run_error": np.array(["", "solver error", ""])}
+    store.write(2, [6, 7, 8], arrays)
+    # a temporary file left by a killed writer is ignored
+    (tmp_path / "p" / ".chunk-000003.npz.xyz.tmp").write_bytes(b"half")
+    assert store.completed() == {2}
+    cases, back = ChunkStore(tmp_path / "p", "abc").open().read(2)
+    np.testing.assert_array_equal(cases, [6, 7, 8])
+    np.testing.assert_array_equal(back["peak_ship_slip"], arrays["peak_ship_slip"])
+    assert list(back["run_error"]) == ["", "solver error", ""]
+    with pytest.raises(StoreError, match="different run"):
+        ChunkStore(tmp_path / "p", "other").open()
+    store.remove()
+    assert not (tmp_path / "p").exists()
+
+
+def test_unreadable_chunk_raises_store_error(tmp_path):
+    store = ChunkStore(tmp_path / "p", "abc").open()
+    (tmp_path / "p" / "chunk-000000.npz").write_bytes(b"garbage")
+    assert store.completed() == {0}
+    with pytest.raises(StoreError, match="unreadable"):
+        store.read(0)
+    store.discard(0)
+    assert store.completed() == set()
+
+
+def _dataset():
+    return xr.Dataset(
+        {
+            "peak_ship_slip": (("record", "im_level"), np.array([[0.0, np.nan], [0.1, 0.2]]),
+                               {"units": "m", "long_name": "peak ship slip"}),
+            "record_error": (("record",), np.array(["", "bad file"], dtype=object),
+                             {"units": "1", "long_name": "record error"}),
+            "exceeded": (("record", "im_level"), np.array([[False, True], [True, True]]),
+                         {"units": "1", "long_name": "exceeded"}),
+        },
+        coords={
+            "record": ("record", np.array(["a", "b"], dtype=object),
+                       {"units": "1", "long_name": "record"}),
+            "im_level": ("im_level", [1.0, 2.0], {"units": "m/s^2", "long_name": "level"}),
+        },
+        attrs={"pipeline": "x = 1\n"},
+    )
+
+
+def test_write_dataset_is_compressed_and_round_trips(tmp_path):
+    ds = _dataset()
+    path = write_dataset(ds, tmp_path / "sub" / "r.nc")
+    assert [p.name for p in path.parent.iterdir()] == ["r.nc"]  # no temporary file left
+    back = open_results(path)
+    xr.testing.assert_identical(back, ds)
+    assert back["peak_ship_slip"].encoding["zlib"] is True
+    assert back["exceeded"].dtype == bool
+    with xr.open_dataset(path) as plain:
+        xr.testing.assert_identical(plain.load(), ds)
+
+
+def test_write_dataset_refuses_missing_metadata_and_keeps_old_file(tmp_path):
+    path = write_dataset(_dataset(), tmp_path / "r.nc")
+    before = path.read_bytes()
+    bad = _dataset()
+    del bad["peak_ship_slip"].attrs["units"]
+    with pytest.raises(StoreError, match="'peak_ship_slip' has no 'units'"):
+        check_metadata(bad)
+    with pytest.raises(StoreError):
+        write_dataset(bad, path)
+    assert path.read_bytes() == before
