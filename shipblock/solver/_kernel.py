@@ -53,6 +53,7 @@ EV_S_SLIP = 6  # ship slides: sigma2 * v_s
 EV_SEP_G = 7  # fy > 0
 EV_SEP_S = 8  # Fy > 0
 N_EVENTS = 9
+EV_ROTATION_PEAK = 9  # not a transition: theta_dot changes sign (locates peak rotations)
 #: Order in which simultaneous events are taken: failures first, then velocity events.
 EVENT_PRIORITY = np.array(
     [EV_SEP_G, EV_SEP_S, EV_OVERTURN, EV_IMPACT, EV_G_SLIP, EV_S_SLIP, EV_UPLIFT, EV_G_STICK,
@@ -332,6 +333,8 @@ def hermite_extremum(g0, d0, g1, d1):
 def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g):
     """Event function ``e`` after advancing ``y0`` by ``h`` (state left in ``y1``)."""
     advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
+    if e == EV_ROTATION_PEAK:
+        return y1[Y_OM] if y0[Y_OM] > 0.0 else -y1[Y_OM]
     event_values(p, ms, y1, k, tau + h, dt, ax, ay, has_ay, sh, sv, g, w7)
     return g[e]
 
@@ -384,39 +387,17 @@ def mode_number(ms):
 
 
 @njit(cache=True)
-def rotation_extremum(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7):
-    """|theta| at the instant inside a rocking step where theta_dot changes sign.
+def rotation_extremum(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g):
+    """|theta| where theta_dot changes sign inside a rocking step (peak rotation).
 
-    Illinois iteration on the step length for theta_dot = 0, so peak rotations do not depend on
-    where the steps happen to end.
+    Located like an event, so peak rotations do not depend on where the steps happen to end.
     """
-    lo, hi = 0.0, h
-    w_lo = y0[Y_OM]
-    advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
-    w_hi = y1[Y_OM]
-    best = abs(y1[Y_TH])
-    side = 0
-    for _ in range(100):
-        if hi - lo <= ROOT_TIME_TOL:
-            break
-        mid = hi - w_hi * (hi - lo) / (w_hi - w_lo)
-        width = hi - lo
-        if not (lo + 0.01 * width < mid < hi - 0.01 * width):
-            mid = 0.5 * (lo + hi)
-        advance(p, ms, y0, k, tau, mid, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
-        wm = y1[Y_OM]
-        best = max(best, abs(y1[Y_TH]))
-        if (wm > 0.0) == (w_hi > 0.0):
-            hi, w_hi = mid, wm
-            if side == -1:
-                w_lo *= 0.5
-            side = -1
-        else:
-            lo, w_lo = mid, wm
-            if side == 1:
-                w_hi *= 0.5
-            side = 1
-    return best
+    w_end = event_after(EV_ROTATION_PEAK, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv,
+                        y1, stages, ytmp, w7, g)
+    root = locate_root(EV_ROTATION_PEAK, 0.0, abs(y0[Y_OM]), h, w_end, p, ms, y0, k, tau, dt,
+                       ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g)
+    advance(p, ms, y0, k, tau, root, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
+    return abs(y1[Y_TH])
 
 
 @njit(cache=True)
@@ -539,9 +520,7 @@ def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
                     if key1 < best_key1:
                         better = True
                     elif key1 == best_key1:
-                        if key2 < best_key2:
-                            better = True
-                        elif key2 == best_key2 and mode < best_mode:
+                        if key2 < best_key2 or key2 == best_key2 and mode < best_mode:
                             better = True
                 if better:
                     best_key0, best_key1, best_key2, best_mode = key0, key1, key2, mode
@@ -748,7 +727,7 @@ def run(p, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, mode
             # accept the whole step
             if rocking and y[Y_OM] * y1[Y_OM] < 0.0:
                 ext = rotation_extremum(p, ms, y, k, tau, h, dt, ax, ay, has_ay, sh, sv, yr,
-                                        stages, ytmp, w7)
+                                        stages, ytmp, w7, gw)
                 if ext > peak_th:
                     peak_th = ext
                     peak_th_time = k * dt + tau

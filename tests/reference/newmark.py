@@ -12,7 +12,6 @@ Geotechnique 15(2), 139-160.
 
 from __future__ import annotations
 
-
 import numpy as np
 
 
@@ -80,10 +79,10 @@ def newmark_slip(a, ay, dt, mu, g=9.80665):
                 t_stop = _first_root(coeffs, tau, dt)
                 t_end = dt if t_stop is None else t_stop
 
-                def vel(t):
+                def vel(t, vc=vc, c0=c0, c1=c1, tau=tau):
                     return vc + c0 * (t - tau) + c1 * (t * t - tau * tau) / 2
 
-                def pos(t):
+                def pos(t, xc=xc, vc=vc, c0=c0, c1=c1, tau=tau):
                     s = t - tau
                     return xc + vc * s + c0 * s * s / 2 + c1 * (s**3 / 6 + tau * s * s / 2)
 
