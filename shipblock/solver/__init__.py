@@ -8,6 +8,7 @@ returns their summaries.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
@@ -183,6 +184,15 @@ def simulate(
         for t, k, f, to in zip(ev_t, ev_k, ev_f, ev_to, strict=True)
     ]
     summ = _summary_dict(summary, system)
+    if summ["n_mode_fallbacks"] > 0:
+        warnings.warn(
+            f"no mode was consistent at {int(summ['n_mode_fallbacks'])} event(s); the least-violating "
+            "candidate was taken. This happens in the Painleve regime of rocking with Coulomb "
+            "friction (mu_k > tan(phi) while the pivot slides against the rocking direction), "
+            "where the rigid-body model has no consistent solution; see docs/theory/transitions.",
+            RuntimeWarning,
+            stacklevel=2,
+        )
     fail = failure_name(summary[K.S_FAILURE])
     return SimulationResult(
         time=time,
