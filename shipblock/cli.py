@@ -111,18 +111,6 @@ def _load_motion(args):
     return motion
 
 
-def _motion_name(motion) -> str:
-    """Catalogue id, or NET.STA, of a GroundMotion."""
-    md = motion.metadata
-    cat = md.get("catalogue") or {}
-    if cat.get("id"):
-        return str(cat["id"])
-    st = md.get("station")
-    if isinstance(st, dict):
-        return f"{st.get('network', '')}.{st.get('station', '')}"
-    return str(st or md.get("name") or "record")
-
-
 # --------------------------------------------------------------------------- subcommands
 def _system_from_args(args):
     from shipblock.system import ShipBlockSystem
@@ -146,7 +134,7 @@ def cmd_simulate(args):
     log.info("simulating %d samples at dt = %g s", ax.size, motion.dt)
     res = simulate(system, ax, ay, motion.dt, rtol=args.rtol)
     out = sys.stdout
-    name = _motion_name(motion)
+    name = motion.name
     s = res.summary
     rows = [
         ("record", f"{name} ({ax.size} samples, dt = {motion.dt:g} s, "
@@ -228,7 +216,7 @@ def cmd_info(args):
     out = sys.stdout
     md = motion.metadata
     site = (md.get("catalogue") or {}).get("site", "")
-    out.write(f"record      {_motion_name(motion)} {site}\n")
+    out.write(f"record      {motion.name} {site}\n")
     for f in md.get("source_files", []):
         out.write(f"file        {f}\n")
     out.write(f"start       {motion.starttime}\n")
@@ -265,7 +253,7 @@ def cmd_process(args):
     outdir = Path(args.output_dir)
     outdir.mkdir(parents=True, exist_ok=True)
     st = motion.stream.copy()
-    name = _motion_name(motion)
+    name = motion.name
     stem = name.replace("/", "_")
     fmt = args.format.upper()
     ext = {"MSEED": "mseed", "SAC": "sac"}[fmt]

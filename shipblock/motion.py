@@ -779,6 +779,18 @@ class GroundMotion:
         return self._stream
 
     @property
+    def name(self) -> str:
+        """Short name: the catalogue id, else NET.STA, else the name given to :meth:`from_arrays`."""
+        md = self._metadata
+        cat = md.get("catalogue") or {}
+        if cat.get("id"):
+            return str(cat["id"])
+        st = md.get("station")
+        if isinstance(st, dict):
+            return f"{st.get('network', '')}.{st.get('station', '')}"
+        return str(st or md.get("name") or "record")
+
+    @property
     def metadata(self) -> dict:
         """dict: Provenance: station, event, channels, azimuths, files, units, processing."""
         return self._metadata

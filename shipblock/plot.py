@@ -223,7 +223,7 @@ def plot_record(motion, axes=None, label=None):
 
     if hasattr(motion, "horizontal"):
         h, v, dt = motion.horizontal, motion.vertical, motion.dt
-        label = label or motion.metadata.get("station") or motion.metadata.get("name")
+        label = label or motion.name
     else:
         h, v, dt = motion
     if axes is None:
@@ -245,6 +245,7 @@ def plot_record(motion, axes=None, label=None):
     axes[0].legend(loc="upper right", fontsize=8)
     for ax in axes:
         ax.grid(True, lw=0.3, alpha=0.5)
+    axes[0].set_xlim(*active_window(t, h, margin=3.0))
     if label:
         fig.suptitle(str(label))
     return axes
