@@ -421,6 +421,8 @@ def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
     """
     a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + ONE_SIDED_DT, dt)
     G = p[P_G] + b
+    if G <= 0.0:
+        return 2  # the ground falls at least as fast as gravity: nothing presses the bodies together
     weight = (p[P_NM] + p[P_M]) * p[P_G]
     ship_weight = p[P_M] * p[P_G]
     vb, th, om, vs = y[Y_VB], y[Y_TH], y[Y_OM], y[Y_VS]
