@@ -15,7 +15,7 @@ import numpy as np
 
 from shipblock.result import Energy, Event, SimulationResult, event_kind_name, failure_name
 from shipblock.solver import _kernel as K
-from shipblock.system import P_G, P_M, P_NI, P_NM, P_R, P_THC, ShipBlockSystem
+from shipblock.system import P_THC, ShipBlockSystem
 
 #: Default relative tolerance of the rocking integration [-].
 DEFAULT_RTOL = 1e-8
@@ -161,7 +161,7 @@ def simulate(
                              f"{system.critical_angle:.6g} rad")
     p = system.to_parameter_vector()
     n = ax.size
-    hist = np.empty((n, K.N_STATE))
+    hist = np.empty((n, K.N_HIST))
     modes = np.empty(n, dtype=np.int64)
     summary = np.empty(K.N_SUMMARY)
     ev_t, ev_k, ev_f, ev_to = K.run(
@@ -171,11 +171,10 @@ def simulate(
     time = np.arange(n) * float(dt)
     theta = hist[:, K.Y_TH]
     vb, om, vs = hist[:, K.Y_VB], hist[:, K.Y_OM], hist[:, K.Y_VS]
-    kinetic, potential = _energies(p, theta, vb, om, vs)
     energy = Energy(
         input_work=hist[:, K.Y_WIN].copy(),
-        kinetic=kinetic,
-        potential=potential,
+        kinetic=hist[:, K.H_KIN].copy(),
+        potential=hist[:, K.H_POT].copy(),
         friction=hist[:, K.Y_DIS].copy(),
         impact=hist[:, K.Y_IMP].copy(),
     )
@@ -212,23 +211,6 @@ def simulate(
         ground_acceleration=(ax.copy(), ay_arr.copy()),
         options={"rtol": rtol, "atol": atol, "zeno_omega": zeno_omega},
     )
-
-
-def _energies(p, theta, vb, om, vs):
-    """Kinetic and potential energy at the samples (vectorised form of the kernel's)."""
-    M, nm, R = p[P_M], p[P_NM], p[P_R]
-    c = np.cos(p[P_THC] - np.abs(theta))
-    rc = R * c
-    kinetic = 0.5 * (
-        (nm + M) * vb**2
-        + (p[P_NI] + (nm + 4 * M) * R**2) * om**2
-        + M * vs**2
-        - 2 * (nm + 2 * M) * rc * vb * om
-        + 2 * M * vb * vs
-        - 4 * M * rc * om * vs
-    )
-    potential = (nm + 2 * M) * p[P_G] * R * (c - math.cos(p[P_THC]))
-    return kinetic, potential
 
 
 def _summary_dict(summary: np.ndarray, system: ShipBlockSystem) -> dict:

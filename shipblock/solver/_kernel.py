@@ -38,6 +38,9 @@ from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R, P_TH
 Y_XB, Y_TH, Y_XS, Y_VB, Y_OM, Y_VS, Y_WIN, Y_DIS, Y_IMP = 0, 1, 2, 3, 4, 5, 6, 7, 8
 N_STATE = 9  # the last three accumulate input work, friction dissipation and impact loss [J]
 N_DYN = 6  # components under error control
+# Extra columns of the stored history: kinetic and potential energy at the samples [J].
+H_KIN, H_POT = N_STATE, N_STATE + 1
+N_HIST = N_STATE + 2
 
 # Mode state vector: interface flags and signs.
 MS_SLIP1, MS_ROCK, MS_SLIP2, MS_S, MS_SIG1, MS_SIG2 = 0, 1, 2, 3, 4, 5
@@ -571,7 +574,7 @@ def run(p, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, mode
     zeno_omega : float
         Rocking stops when an impact leaves less than this angular velocity [rad/s].
     store : bool
-        Fill ``hist`` (n x N_STATE) and ``modes`` (n) at the samples.
+        Fill ``hist`` (n x N_HIST: state, kinetic and potential energy) and ``modes`` (n).
     hist, modes : ndarray
         History outputs (ignored unless ``store``).
     summary : ndarray, shape (N_SUMMARY,)
@@ -636,9 +639,7 @@ def run(p, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, mode
         uplift = 1
     event_values(p, ms, y, 0, 0.0, dt, ax, ay, has_ay, sh, sv, g0, w7)
     if store:
-        for i in range(N_STATE):
-            hist[0, i] = y[i]
-        modes[0] = 0 if failure else mode_number(ms)
+        store_sample(p, ms, y, hist, modes, 0, failure != 0)
     h_rock = dt
     events_here = 0
     while k < n - 1 and failure == 0:
@@ -838,13 +839,11 @@ def run(p, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, mode
             tau = 0.0
             events_here = 0
             if store:
-                for i in range(N_STATE):
-                    hist[k, i] = y[i]
-                modes[k] = mode_number(ms)
+                store_sample(p, ms, y, hist, modes, k, False)
     end_time = k * dt + tau
     if failure != 0 and store:
         for j in range(k + 1, n):
-            for i in range(N_STATE):
+            for i in range(N_HIST):
                 hist[j, i] = np.nan
             modes[j] = 0
     summary[S_PEAK_XB] = peak_xb
@@ -871,6 +870,17 @@ def run(p, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, mode
         ev_f[:n_ev] if store else ev_f[:0], ev_to[:n_ev] if store else ev_to[:0]
 
 
+@njit(cache=True)
+def store_sample(p, ms, y, hist, modes, k, failed):
+    """Write the state, kinetic and potential energy and mode of sample ``k``."""
+    for i in range(N_STATE):
+        hist[k, i] = y[i]
+    s = float(ms[MS_S]) if ms[MS_ROCK] else 1.0
+    hist[k, H_KIN] = kinetic_energy(p, y[Y_TH], s, ms[MS_ROCK], y[Y_VB], y[Y_OM], y[Y_VS])
+    hist[k, H_POT] = potential_energy(p, y[Y_TH])
+    modes[k] = 0 if failed else mode_number(ms)
+
+
 @njit(cache=True, parallel=True)
 def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
              case_sv, rtol, atol, zeno_omega, summaries):
@@ -880,7 +890,7 @@ def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params
     ``offsets[r]:offsets[r+1]``. Only summaries are produced.
     """
     n_cases = case_record.shape[0]
-    empty_hist = np.zeros((0, N_STATE))
+    empty_hist = np.zeros((0, N_HIST))
     empty_modes = np.zeros(0, dtype=np.int64)
     at_rest = np.zeros(N_DYN)
     for c in prange(n_cases):
