@@ -1,12 +1,14 @@
 """Compiled event-driven integration of the ship-block system.
 
 One loop serves every mode. Between two input samples the ground acceleration is linear in
-time; the loop advances the state with Dormand-Prince 5(4) steps that never cross a sample, so
-rest and sliding phases are exact and rocking phases are error-controlled. After every step the
-event functions (one per constraint of the current mode, see ``EV_*``) are checked; when one
-changes sign its root is located by the Illinois method on the step length, the state is
-advanced to the root, the event is applied, and the next mode is chosen among all candidate
-modes consistent with the velocities by :func:`select_mode`.
+time. Rest and sliding phases are handed to :func:`~shipblock.solver._closed_form.nonrocking_span`,
+which advances them exactly and finds their events in closed form, sample after sample, until
+an event. Rocking phases are advanced by Dormand-Prince 5(4) steps that never cross a sample,
+with error control; after every step the event functions (one per constraint of the current
+mode, see ``EV_*``) are checked, and when one changes sign its root is located by the Illinois
+method on the step length (an impact starting from the root of the step's quintic
+interpolant). The state is advanced to the root, the event is applied, and the next mode is
+chosen among all candidate modes consistent with the velocities by :func:`select_mode`.
 
 Nothing here allocates per step; the kernels take only arrays and scalars.
 """
@@ -31,71 +33,80 @@ from shipblock.equations import (
 )
 from shipblock.impact import apply_impact
 from shipblock.modes import MODE_NUMBER, EventKind, Failure
+from shipblock.solver._closed_form import nonrocking_span
 from shipblock.solver._dopri import DP_A, DP_C, DP_E, DP_ERROR_ORDER
-from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R, P_THC
-
-# State vector.
-Y_XB, Y_TH, Y_XS, Y_VB, Y_OM, Y_VS, Y_WIN, Y_DIS, Y_IMP = 0, 1, 2, 3, 4, 5, 6, 7, 8
-N_STATE = 9  # the last three accumulate input work, friction dissipation and impact loss [J]
-N_DYN = 6  # components under error control
-# Extra columns of the stored history: kinetic and potential energy at the samples [J].
-H_KIN, H_POT = N_STATE, N_STATE + 1
-N_HIST = N_STATE + 2
-
-# Mode state vector: interface flags and signs.
-MS_SLIP1, MS_ROCK, MS_SLIP2, MS_S, MS_SIG1, MS_SIG2 = 0, 1, 2, 3, 4, 5
-
-# Event functions; each is >= 0 while its constraint holds.
-EV_G_STICK = 0  # blocks stick on the ground: mu_s1 fy - |fx|
-EV_G_SLIP = 1  # blocks slide: sigma1 * v_b
-EV_UPLIFT = 2  # blocks at rest: B (fy + Fy) - H |fx + Fx|
-EV_IMPACT = 3  # rocking: s * theta
-EV_OVERTURN = 4  # rocking: theta_c - s * theta
-EV_S_STICK = 5  # ship sticks: mu_s2 Fy - |Fx|
-EV_S_SLIP = 6  # ship slides: sigma2 * v_s
-EV_SEP_G = 7  # fy > 0
-EV_SEP_S = 8  # Fy > 0
-N_EVENTS = 9
-EV_ROTATION_PEAK = 9  # not a transition: theta_dot changes sign (locates peak rotations)
-#: Order in which simultaneous events are taken: failures first, then velocity events.
-EVENT_PRIORITY = np.array(
-    [EV_SEP_G, EV_SEP_S, EV_OVERTURN, EV_IMPACT, EV_G_SLIP, EV_S_SLIP, EV_UPLIFT, EV_G_STICK,
-     EV_S_STICK],
-    dtype=np.int64,
+from shipblock.solver._events import event_functions
+from shipblock.solver._interpolate import (
+    bracketed_root,
+    hermite_extremum,
+    poly5,
+    quintic_hermite,
 )
-
-# Summary vector of one run.
-S_PEAK_XB = 0
-S_PEAK_TH = 1
-S_PEAK_XS = 2
-S_RES_XB = 3
-S_RES_XS = 4
-S_UPLIFT = 5
-S_N_IMPACTS = 6
-S_FAILURE = 7
-S_FAILURE_TIME = 8
-S_MODE_TIME = 9  # 8 entries, modes 1..8
-S_END_TIME = 17
-S_N_EVENTS = 18
-S_W_IN = 19
-S_DISSIPATED = 20
-S_IMPACT_LOSS = 21
-S_N_FALLBACK = 22
-S_ENERGY_FINAL = 23  # T + V at the end
-S_PEAK_TH_TIME = 24
-N_SUMMARY = 25
-
-# Numerical constants (documented in docs/theory/solver.md).
-ROOT_TIME_TOL = 1e-12  # [s] width of the bracket that locates an event
-ONE_SIDED_DT = 1e-8  # [s] candidate modes are checked this long after an event
-FORCE_TOL = 1e-10  # [-] tolerance on force margins, relative to the weight
-ACC_TOL = 1e-10  # [-] a new motion must accelerate by more than this times g
-REARM_TOL = 1e-9  # [-] a disarmed event is re-armed once its function exceeds this
-MIN_STEP = 1e-13  # [s] smallest rocking step before the run is declared failed
-MAX_EVENTS_PER_SAMPLE = 20000  # guards against chattering
-SAFETY = 0.9
-MIN_FACTOR = 0.2
-MAX_FACTOR = 5.0
+from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrappers)
+    ACC_TOL,
+    EV_G_SLIP,
+    EV_G_STICK,
+    EV_IMPACT,
+    EV_OVERTURN,
+    EV_ROTATION_PEAK,
+    EV_S_SLIP,
+    EV_S_STICK,
+    EV_SEP_G,
+    EV_SEP_S,
+    EV_UPLIFT,
+    EVENT_PRIORITY,
+    FORCE_TOL,
+    GUESS_PROBE,
+    H_KIN,
+    H_POT,
+    MAX_EVENTS_PER_SAMPLE,
+    MAX_FACTOR,
+    MIN_FACTOR,
+    MIN_STEP,
+    MS_ROCK,
+    MS_S,
+    MS_SIG1,
+    MS_SIG2,
+    MS_SLIP1,
+    MS_SLIP2,
+    N_DYN,
+    N_EVENTS,
+    N_HIST,
+    N_STATE,
+    N_SUMMARY,
+    ONE_SIDED_DT,
+    REARM_TOL,
+    ROOT_TIME_TOL,
+    S_DISSIPATED,
+    S_END_TIME,
+    S_ENERGY_FINAL,
+    S_FAILURE,
+    S_FAILURE_TIME,
+    S_IMPACT_LOSS,
+    S_MODE_TIME,
+    S_N_EVENTS,
+    S_N_FALLBACK,
+    S_N_IMPACTS,
+    S_PEAK_TH,
+    S_PEAK_TH_TIME,
+    S_PEAK_XB,
+    S_PEAK_XS,
+    S_RES_XB,
+    S_RES_XS,
+    S_UPLIFT,
+    S_W_IN,
+    SAFETY,
+    Y_DIS,
+    Y_IMP,
+    Y_OM,
+    Y_TH,
+    Y_VB,
+    Y_VS,
+    Y_WIN,
+    Y_XB,
+    Y_XS,
+)
+from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
 
 @njit(cache=True)
@@ -117,12 +128,6 @@ def ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt):
         b0 = sv * ay[k]
         b = b0 + (sv * ay[k + 1] - b0) * f
     return a, b
-    f = tau / dt
-    a = ax[k] + (ax[k + 1] - ax[k]) * f
-    b = 0.0
-    if has_ay:
-        b = ay[k] + (ay[k + 1] - ay[k]) * f
-    return sh * a, sv * b
 
 
 @njit(cache=True)
@@ -208,12 +213,15 @@ def advance_polynomial(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, sta
 
 
 @njit(cache=True)
-def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7):
+def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
+            first_stage_known=False):
     """Advance ``y0`` by ``h`` within sample interval ``k``; returns 0, or -1 if singular.
 
     Rest: the state does not change. Sliding (no rocking): exact polynomial update. Rocking:
     one Dormand-Prince 5(4) step (its error estimate is read from ``stages`` by
-    :func:`error_norm`).
+    :func:`error_norm`); with ``first_stage_known`` the first stage, f(t, y0), is taken from
+    ``stages[0]`` as left there by the previous step (first same as last) or by an earlier
+    step from the same ``y0``.
     """
     n = y0.shape[0]
     if is_static(ms, y0) or h == 0.0:
@@ -223,6 +231,8 @@ def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, 
     if ms[MS_ROCK] == 0:
         return advance_polynomial(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages)
     for st in range(7):
+        if st == 0 and first_stage_known:
+            continue
         for i in range(n):
             acc = y0[i]
             for j in range(st):
@@ -258,26 +268,7 @@ def event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g, w7):
         p, ms[MS_SLIP1], ms[MS_ROCK], ms[MS_SLIP2], float(ms[MS_S]), float(ms[MS_SIG1]),
         float(ms[MS_SIG2]), y[Y_TH], y[Y_OM], a, p[P_G] + b, w7,
     )
-    weight = (p[P_NM] + p[P_M]) * p[P_G]
-    ship_weight = p[P_M] * p[P_G]
-    fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
-    for e in range(N_EVENTS):
-        g[e] = 1.0
-    if ms[MS_SLIP1]:
-        g[EV_G_SLIP] = ms[MS_SIG1] * y[Y_VB]
-    else:
-        g[EV_G_STICK] = (p[P_MUS1] * fy - abs(fx)) / weight
-    if ms[MS_ROCK]:
-        g[EV_IMPACT] = ms[MS_S] * y[Y_TH]
-        g[EV_OVERTURN] = p[P_THC] - ms[MS_S] * y[Y_TH]
-    else:
-        g[EV_UPLIFT] = (p[P_B] * (fy + Fy) - p[P_H] * abs(fx + Fx)) / (weight * p[P_R])
-    if ms[MS_SLIP2]:
-        g[EV_S_SLIP] = ms[MS_SIG2] * y[Y_VS]
-    else:
-        g[EV_S_STICK] = (p[P_MUS2] * Fy - abs(Fx)) / ship_weight
-    g[EV_SEP_G] = fy / weight
-    g[EV_SEP_S] = Fy / ship_weight
+    event_functions(p, ms, y, w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY], g)
     return ok
 
 
@@ -299,43 +290,12 @@ def has_slope(e):
 
 
 @njit(cache=True)
-def hermite_extremum(g0, d0, g1, d1):
-    """Interior extremum of the cubic Hermite interpolant on [0, 1]: (u, value) or (-1, 0).
-
-    ``d0`` and ``d1`` are the end slopes scaled to the unit interval.
-    """
-    # p(u) = g0 + d0 u + c2 u^2 + c3 u^3
-    c2 = 3.0 * (g1 - g0) - 2.0 * d0 - d1
-    c3 = 2.0 * (g0 - g1) + d0 + d1
-    # p'(u) = d0 + 2 c2 u + 3 c3 u^2
-    qa, qb, qc = 3.0 * c3, 2.0 * c2, d0
-    best_u = -1.0
-    best_v = 0.0
-    if abs(qa) < 1e-300:
-        if qb != 0.0:
-            u = -qc / qb
-            if 0.0 < u < 1.0:
-                best_u = u
-    else:
-        disc = qb * qb - 4.0 * qa * qc
-        if disc >= 0.0:
-            sq = math.sqrt(disc)
-            for u in ((-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)):
-                if 0.0 < u < 1.0:
-                    v = g0 + d0 * u + c2 * u * u + c3 * u * u * u
-                    if best_u < 0.0 or (d0 < 0.0 and v < best_v) or (d0 > 0.0 and v > best_v):
-                        best_u = u
-                        best_v = v
-    if best_u >= 0.0:
-        u = best_u
-        best_v = g0 + d0 * u + c2 * u * u + c3 * u * u * u
-    return best_u, best_v
-
-
-@njit(cache=True)
 def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g):
-    """Event function ``e`` after advancing ``y0`` by ``h`` (state left in ``y1``)."""
-    advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
+    """Event function ``e`` after advancing ``y0`` by ``h`` (state left in ``y1``).
+
+    Called only after a step from ``y0``, so ``stages[0]`` already holds f(t, y0).
+    """
+    advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, True)
     if e == EV_ROTATION_PEAK:
         return y1[Y_OM] if y0[Y_OM] > 0.0 else -y1[Y_OM]
     event_values(p, ms, y1, k, tau + h, dt, ax, ay, has_ay, sh, sv, g, w7)
@@ -343,13 +303,31 @@ def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages,
 
 
 @njit(cache=True)
-def locate_root(e, lo, g_lo, hi, g_hi, p, ms, y0, k, tau, dt, ax, ay, has_ay, sh, sv,
+def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has_ay, sh, sv,
                 y1, stages, ytmp, w7, g):
     """Illinois iteration for the step length at which event ``e`` crosses zero.
 
-    ``g_lo >= 0 > g_hi``. Returns the violated end of the final bracket (width
-    <= ROOT_TIME_TOL), so the event has just happened there.
+    ``g_lo >= 0 > g_hi``. ``guess`` (ignored unless inside the bracket) is a first estimate of
+    the root, e.g. from an interpolant: it and a point ``GUESS_PROBE`` beyond it are tried
+    first, which usually leaves a bracket a few ``ROOT_TIME_TOL`` wide. Returns the violated
+    end of the final bracket (width <= ROOT_TIME_TOL), so the event has just happened there.
     """
+    if lo < guess < hi:
+        gm = event_after(e, p, ms, y0, k, tau, guess, dt, ax, ay, has_ay, sh, sv,
+                         y1, stages, ytmp, w7, g)
+        if gm < 0.0:
+            hi, g_hi = guess, gm
+            probe = guess - GUESS_PROBE
+        else:
+            lo, g_lo = guess, gm
+            probe = guess + GUESS_PROBE
+        if lo < probe < hi:
+            gm = event_after(e, p, ms, y0, k, tau, probe, dt, ax, ay, has_ay, sh, sv,
+                             y1, stages, ytmp, w7, g)
+            if gm < 0.0:
+                hi, g_hi = probe, gm
+            else:
+                lo, g_lo = probe, gm
     side = 0
     for _ in range(200):
         if hi - lo <= ROOT_TIME_TOL:
@@ -390,17 +368,24 @@ def mode_number(ms):
 
 
 @njit(cache=True)
-def rotation_extremum(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g):
-    """|theta| where theta_dot changes sign inside a rocking step (peak rotation).
+def rotation_extremum(y0, y1, al0, al1, h):
+    """Peak |theta| inside a rocking step in which theta_dot changes sign, and its time.
 
-    Located like an event, so peak rotations do not depend on where the steps happen to end.
+    Read off the quintic Hermite interpolant of the step (no further integration), so peak
+    rotations and their times do not depend on where the steps happen to end.
+
+    Returns
+    -------
+    peak : float
+        |theta| at the extremum [rad].
+    s : float
+        Its time after the start of the step [s].
     """
-    w_end = event_after(EV_ROTATION_PEAK, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv,
-                        y1, stages, ytmp, w7, g)
-    root = locate_root(EV_ROTATION_PEAK, 0.0, abs(y0[Y_OM]), h, w_end, p, ms, y0, k, tau, dt,
-                       ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g)
-    advance(p, ms, y0, k, tau, root, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
-    return abs(y1[Y_TH])
+    c0, c1, c2, c3, c4, c5 = quintic_hermite(y0[Y_TH], y0[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h)
+    u = bracketed_root(c0, c1, c2, c3, c4, c5, 0.0, 1.0, True)
+    if u < 0.0:
+        return max(abs(y0[Y_TH]), abs(y1[Y_TH])), 0.0
+    return abs(poly5(c0, c1, c2, c3, c4, c5, u)), u * h
 
 
 @njit(cache=True)
@@ -433,108 +418,116 @@ def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
     best_key1 = 1e300
     best_key2 = 2
     best_mode = 99
-    best = np.zeros(6, dtype=np.int64)
+    best0 = best1 = best2 = best3 = best4 = best5 = 0
     all_separate = True
-    # option lists: (flag, sign)
-    for i1 in range(3):
-        if vb != 0.0:
-            if i1 > 0:
-                continue
-            slip1, sig1 = 1, (1 if vb > 0.0 else -1)
-            new1 = 0
-        else:
-            slip1 = 0 if i1 == 0 else 1
-            sig1 = -1 if i1 == 2 else 1
-            new1 = slip1
-        for ir in range(3):
-            if th != 0.0 or om != 0.0:
-                if ir > 0:
+    # Candidates are visited by the number of new motions they start: a consistent candidate
+    # with fewer new motions beats every one with more, so the search ends at the first level
+    # holding a consistent candidate (usually the first: nothing new starts). The fallback
+    # (no consistent candidate) has then compared the violations of all of them.
+    for level in range(4):
+        # option lists: (flag, sign)
+        for i1 in range(3):
+            if vb != 0.0:
+                if i1 > 0:
                     continue
-                rock = 1
-                ref = th if th != 0.0 else om
-                s = 1 if ref > 0.0 else -1
-                newr = 0
+                slip1, sig1 = 1, (1 if vb > 0.0 else -1)
+                new1 = 0
             else:
-                rock = 0 if ir == 0 else 1
-                s = -1 if ir == 2 else 1
-                newr = rock
-            for i2 in range(3):
-                if vs != 0.0:
-                    if i2 > 0:
+                slip1 = 0 if i1 == 0 else 1
+                sig1 = -1 if i1 == 2 else 1
+                new1 = slip1
+            for ir in range(3):
+                if th != 0.0 or om != 0.0:
+                    if ir > 0:
                         continue
-                    slip2, sig2 = 1, (1 if vs > 0.0 else -1)
-                    new2 = 0
+                    rock = 1
+                    ref = th if th != 0.0 else om
+                    s = 1 if ref > 0.0 else -1
+                    newr = 0
                 else:
-                    slip2 = 0 if i2 == 0 else 1
-                    sig2 = -1 if i2 == 2 else 1
-                    new2 = slip2
-                ok = solve_mode(p, slip1, rock, slip2, float(s), float(sig1), float(sig2),
-                                th, om, a, G, w7)
-                if not ok:
-                    continue
-                fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
-                viol = 0.0
-                separate = fy <= 0.0 or Fy <= 0.0
-                if not separate:
-                    all_separate = False
-                else:
-                    viol += max(0.0, -fy / weight) + max(0.0, -Fy / ship_weight) + 1.0
-                if slip1 == 0:
-                    v = (abs(fx) - p[P_MUS1] * fy) / weight
-                    if v > FORCE_TOL:
-                        viol += v
-                elif new1:
-                    v = sig1 * w7[0] / p[P_G]
-                    if v <= ACC_TOL:
-                        viol += ACC_TOL - v
-                if rock == 0:
-                    v = (p[P_H] * abs(fx + Fx) - p[P_B] * (fy + Fy)) / (weight * p[P_R])
-                    if v > FORCE_TOL:
-                        viol += v
-                elif newr:
-                    v = s * w7[1] * p[P_R] / p[P_G]
-                    if v <= ACC_TOL:
-                        viol += ACC_TOL - v
-                if slip2 == 0:
-                    v = (abs(Fx) - p[P_MUS2] * Fy) / ship_weight
-                    if v > FORCE_TOL:
-                        viol += v
-                elif new2:
-                    v = sig2 * w7[2] / p[P_G]
-                    if v <= ACC_TOL:
-                        viol += ACC_TOL - v
-                n_new = new1 + newr + new2
-                if trigger == 0:
-                    releases = new1
-                elif trigger == 1:
-                    releases = newr
-                elif trigger == 2:
-                    releases = new2
-                else:
-                    releases = 0
-                mode = mode_number_of(slip1, rock, slip2)
-                if viol == 0.0:
-                    key0, key1 = 0, float(n_new)
-                else:
-                    key0, key1 = 1, viol
-                key2 = 0 if releases else 1
-                better = False
-                if key0 < best_key0:
-                    better = True
-                elif key0 == best_key0:
-                    if key1 < best_key1:
+                    rock = 0 if ir == 0 else 1
+                    s = -1 if ir == 2 else 1
+                    newr = rock
+                for i2 in range(3):
+                    if vs != 0.0:
+                        if i2 > 0:
+                            continue
+                        slip2, sig2 = 1, (1 if vs > 0.0 else -1)
+                        new2 = 0
+                    else:
+                        slip2 = 0 if i2 == 0 else 1
+                        sig2 = -1 if i2 == 2 else 1
+                        new2 = slip2
+                    if new1 + newr + new2 != level:
+                        continue
+                    ok = solve_mode(p, slip1, rock, slip2, float(s), float(sig1), float(sig2),
+                                    th, om, a, G, w7)
+                    if not ok:
+                        continue
+                    fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
+                    viol = 0.0
+                    separate = fy <= 0.0 or Fy <= 0.0
+                    if not separate:
+                        all_separate = False
+                    else:
+                        viol += max(0.0, -fy / weight) + max(0.0, -Fy / ship_weight) + 1.0
+                    if slip1 == 0:
+                        v = (abs(fx) - p[P_MUS1] * fy) / weight
+                        if v > FORCE_TOL:
+                            viol += v
+                    elif new1:
+                        v = sig1 * w7[0] / p[P_G]
+                        if v <= ACC_TOL:
+                            viol += ACC_TOL - v
+                    if rock == 0:
+                        v = (p[P_H] * abs(fx + Fx) - p[P_B] * (fy + Fy)) / (weight * p[P_R])
+                        if v > FORCE_TOL:
+                            viol += v
+                    elif newr:
+                        v = s * w7[1] * p[P_R] / p[P_G]
+                        if v <= ACC_TOL:
+                            viol += ACC_TOL - v
+                    if slip2 == 0:
+                        v = (abs(Fx) - p[P_MUS2] * Fy) / ship_weight
+                        if v > FORCE_TOL:
+                            viol += v
+                    elif new2:
+                        v = sig2 * w7[2] / p[P_G]
+                        if v <= ACC_TOL:
+                            viol += ACC_TOL - v
+                    n_new = new1 + newr + new2
+                    if trigger == 0:
+                        releases = new1
+                    elif trigger == 1:
+                        releases = newr
+                    elif trigger == 2:
+                        releases = new2
+                    else:
+                        releases = 0
+                    mode = mode_number_of(slip1, rock, slip2)
+                    if viol == 0.0:
+                        key0, key1 = 0, float(n_new)
+                    else:
+                        key0, key1 = 1, viol
+                    key2 = 0 if releases else 1
+                    better = False
+                    if key0 < best_key0:
                         better = True
-                    elif key1 == best_key1:
-                        if key2 < best_key2 or key2 == best_key2 and mode < best_mode:
+                    elif key0 == best_key0:
+                        if key1 < best_key1:
                             better = True
-                if better:
-                    best_key0, best_key1, best_key2, best_mode = key0, key1, key2, mode
-                    best[0], best[1], best[2] = slip1, rock, slip2
-                    best[3], best[4], best[5] = s, sig1, sig2
+                        elif key1 == best_key1:
+                            if key2 < best_key2 or key2 == best_key2 and mode < best_mode:
+                                better = True
+                    if better:
+                        best_key0, best_key1, best_key2, best_mode = key0, key1, key2, mode
+                        best0, best1, best2 = slip1, rock, slip2
+                        best3, best4, best5 = s, sig1, sig2
+        if best_key0 == 0:
+            break
     if all_separate:
         return 2
-    for i in range(6):
-        ms[i] = best[i]
+    ms[0], ms[1], ms[2], ms[3], ms[4], ms[5] = best0, best1, best2, best3, best4, best5
     return 0 if best_key0 == 0 else 1
 
 
@@ -597,6 +590,10 @@ def run(p, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, mode
     w7b = np.zeros(N_SOLVE_OUT)
     K = np.zeros((3, 3))
     g0 = np.zeros(N_EVENTS)
+    f_end = np.zeros(N_STATE)
+    fsal = False  # stages[0] holds f(y) in the current mode
+    resp = np.zeros((2, N_SOLVE_OUT))
+    peaks = np.zeros(2)
     g1 = np.zeros(N_EVENTS)
     gw = np.zeros(N_EVENTS)
     armed = np.ones(N_EVENTS, dtype=np.bool_)
@@ -643,15 +640,36 @@ def run(p, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, mode
     h_rock = dt
     events_here = 0
     while k < n - 1 and failure == 0:
-        remaining = dt - tau
-        rocking = ms[MS_ROCK] == 1
-        h = min(h_rock, remaining) if rocking else remaining
-        err = advance(p, ms, y, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
-        if err < 0.0:
-            failure = Failure.SOLVER_ERROR
-            failure_time = k * dt + tau
-            break
-        if rocking:
+        if ms[MS_ROCK] == 0:
+            # rest and sliding: closed form, sample by sample, up to the next event
+            peaks[0] = peak_xb
+            peaks[1] = peak_xs
+            k_before = k
+            k, tau, best_e, best_h = nonrocking_span(
+                p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary, peaks, store,
+                hist, modes, resp, gw)
+            peak_xb = peaks[0]
+            peak_xs = peaks[1]
+            if k != k_before:
+                events_here = 0
+            if best_e == -1:
+                break  # end of the record
+            if best_e == -2:
+                failure = Failure.SOLVER_ERROR
+                failure_time = k * dt + tau
+                break
+        else:
+            # rocking: error-controlled Dormand-Prince steps within the sample interval, where
+            # the input is linear (a step across a sample would straddle a kink of the input)
+            remaining = dt - tau
+            h = min(h_rock, remaining)
+            err = advance(p, ms, y, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
+                          fsal)
+            fsal = True  # stages[0] holds f(y) now, whatever happens to this step
+            if err < 0.0:
+                failure = Failure.SOLVER_ERROR
+                failure_time = k * dt + tau
+                break
             err = error_norm(y, y1, stages, h, rtol, atol)
             if err > 1.0:
                 h_rock = h * max(MIN_FACTOR, SAFETY * err ** (-1.0 / (DP_ERROR_ORDER + 1)))
@@ -660,95 +678,108 @@ def run(p, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, mode
                     failure_time = k * dt + tau
                     break
                 continue
-        # slopes at the start (from the first stage) for velocity-type events
-        d_start_b = stages[0, Y_VB]
-        d_start_s = stages[0, Y_VS]
-        ok = event_values(p, ms, y1, k, tau + h, dt, ax, ay, has_ay, sh, sv, g1, w7b)
-        if not ok:
-            failure = Failure.SOLVER_ERROR
-            failure_time = k * dt + tau
-            break
-        best_h = h + 1.0
-        best_e = -1
-        for ie in range(N_EVENTS):
-            e = EVENT_PRIORITY[ie]
-            if not armed[e]:
-                continue
-            lo = 0.0
-            g_lo = g0[e]
-            hi = h
-            g_hi = g1[e]
-            fired = False
-            if g1[e] < 0.0:
-                fired = True
-                if g0[e] <= 0.0:
-                    # started on the boundary: look for the interior maximum first
-                    g_lo = 0.0
-                    if has_slope(e):
-                        if e == EV_G_SLIP:
-                            d0 = ms[MS_SIG1] * d_start_b
-                        elif e == EV_S_SLIP:
-                            d0 = ms[MS_SIG2] * d_start_s
-                        else:
-                            d0 = ms[MS_S] * y[Y_OM]
-                        d1 = event_slope(e, ms, y1, w7b)
-                        u, _ = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
-                        if u > 0.0:
+            # slopes at both ends (first and last stage) for the interpolants and event checks
+            d_start_b = stages[0, Y_VB]
+            d_start_s = stages[0, Y_VS]
+            al0 = stages[0, Y_OM]
+            al1 = stages[6, Y_OM]
+            for i in range(N_STATE):
+                f_end[i] = stages[6, i]
+            # the last stage solved the equations at (t + h, y1): its forces give the events
+            for i in range(N_SOLVE_OUT):
+                w7b[i] = w7[i]
+            event_functions(p, ms, y1, w7b[I_FX], w7b[I_FY], w7b[I_SFX], w7b[I_SFY], g1)
+            best_h = h + 1.0
+            best_e = -1
+            for ie in range(N_EVENTS):
+                e = EVENT_PRIORITY[ie]
+                if not armed[e]:
+                    continue
+                lo = 0.0
+                g_lo = g0[e]
+                hi = h
+                g_hi = g1[e]
+                fired = False
+                if g1[e] < 0.0:
+                    fired = True
+                    if g0[e] <= 0.0:
+                        # started on the boundary: look for the interior maximum first
+                        g_lo = 0.0
+                        if has_slope(e):
+                            if e == EV_G_SLIP:
+                                d0 = ms[MS_SIG1] * d_start_b
+                            elif e == EV_S_SLIP:
+                                d0 = ms[MS_SIG2] * d_start_s
+                            else:
+                                d0 = ms[MS_S] * y[Y_OM]
+                            d1 = event_slope(e, ms, y1, w7b)
+                            u, _ = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
+                            if u > 0.0:
+                                gm = event_after(e, p, ms, y, k, tau, u * h, dt, ax, ay, has_ay,
+                                                 sh, sv, yr, stages, ytmp, w7, gw)
+                                if gm > 0.0:
+                                    lo = u * h
+                                    g_lo = gm
+                elif has_slope(e) and g0[e] > 0.0:
+                    if e == EV_G_SLIP:
+                        d0 = ms[MS_SIG1] * d_start_b
+                    elif e == EV_S_SLIP:
+                        d0 = ms[MS_SIG2] * d_start_s
+                    else:
+                        d0 = ms[MS_S] * y[Y_OM]
+                    d1 = event_slope(e, ms, y1, w7b)
+                    if d0 < 0.0 and d1 > 0.0:
+                        u, vmin = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
+                        if u > 0.0 and vmin < 0.0:
                             gm = event_after(e, p, ms, y, k, tau, u * h, dt, ax, ay, has_ay,
                                              sh, sv, yr, stages, ytmp, w7, gw)
-                            if gm > 0.0:
-                                lo = u * h
-                                g_lo = gm
-            elif has_slope(e) and g0[e] > 0.0:
-                if e == EV_G_SLIP:
-                    d0 = ms[MS_SIG1] * d_start_b
-                elif e == EV_S_SLIP:
-                    d0 = ms[MS_SIG2] * d_start_s
-                else:
-                    d0 = ms[MS_S] * y[Y_OM]
-                d1 = event_slope(e, ms, y1, w7b)
-                if d0 < 0.0 and d1 > 0.0:
-                    u, vmin = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
-                    if u > 0.0 and vmin < 0.0:
-                        gm = event_after(e, p, ms, y, k, tau, u * h, dt, ax, ay, has_ay,
-                                         sh, sv, yr, stages, ytmp, w7, gw)
-                        if gm < 0.0:
-                            fired = True
-                            hi = u * h
-                            g_hi = gm
-            if fired:
-                if g_lo > 0.0:
-                    root = locate_root(e, lo, g_lo, hi, g_hi, p, ms, y, k, tau, dt, ax, ay,
-                                       has_ay, sh, sv, yr, stages, ytmp, w7, gw)
-                else:
-                    root = lo
-                # a later-priority event wins only if it is clearly earlier
-                if root < best_h - 2.0 * ROOT_TIME_TOL:
-                    best_h = root
-                    best_e = e
-        if best_e < 0:
-            # accept the whole step
-            if rocking and y[Y_OM] * y1[Y_OM] < 0.0:
-                ext = rotation_extremum(p, ms, y, k, tau, h, dt, ax, ay, has_ay, sh, sv, yr,
-                                        stages, ytmp, w7, gw)
-                if ext > peak_th:
-                    peak_th = ext
-                    peak_th_time = k * dt + tau
-            for i in range(N_STATE):
-                y[i] = y1[i]
-            for e in range(N_EVENTS):
-                g0[e] = g1[e]
-                if not armed[e] and g1[e] > REARM_TOL:
-                    armed[e] = True
-            summary[S_MODE_TIME + mode_number(ms) - 1] += h
-            tau += h
-            if rocking and h < remaining:
-                h_rock = h * min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * max(err, 1e-10) ** (-1.0 / (DP_ERROR_ORDER + 1))))
-            elif rocking:
-                h_rock = max(h_rock, h)
-        else:
-            # advance to the event
-            advance(p, ms, y, k, tau, best_h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7)
+                            if gm < 0.0:
+                                fired = True
+                                hi = u * h
+                                g_hi = gm
+                if fired:
+                    if g_lo > 0.0:
+                        guess = -1.0
+                        if e == EV_IMPACT:
+                            # first guess: the root of the step's quintic interpolant of theta
+                            c0, c1, c2, c3, c4, c5 = quintic_hermite(
+                                y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h)
+                            u = bracketed_root(c0, c1, c2, c3, c4, c5, lo / h, hi / h, False)
+                            if u >= 0.0:
+                                guess = u * h
+                        root = locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y, k, tau, dt,
+                                           ax, ay, has_ay, sh, sv, yr, stages, ytmp, w7, gw)
+                    else:
+                        root = lo
+                    # a later-priority event wins only if it is clearly earlier
+                    if root < best_h - 2.0 * ROOT_TIME_TOL:
+                        best_h = root
+                        best_e = e
+            if best_e < 0:
+                # accept the whole step
+                if y[Y_OM] * y1[Y_OM] < 0.0:
+                    ext, s_ext = rotation_extremum(y, y1, al0, al1, h)
+                    if ext > peak_th:
+                        peak_th = ext
+                        peak_th_time = k * dt + tau + s_ext
+                for i in range(N_STATE):
+                    y[i] = y1[i]
+                    stages[0, i] = f_end[i]  # first same as last: f(y) for the next step
+                fsal = True
+                for e in range(N_EVENTS):
+                    g0[e] = g1[e]
+                    if not armed[e] and g1[e] > REARM_TOL:
+                        armed[e] = True
+                summary[S_MODE_TIME + mode_number(ms) - 1] += h
+                tau += h
+                if h < remaining:
+                    grow = SAFETY * max(err, 1e-10) ** (-1.0 / (DP_ERROR_ORDER + 1))
+                    h_rock = h * min(MAX_FACTOR, max(MIN_FACTOR, grow))
+        if best_e >= 0:
+            # advance to the event and apply it
+            advance(p, ms, y, k, tau, best_h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
+                    fsal)
+            fsal = False
             for i in range(N_STATE):
                 y[i] = y1[i]
             summary[S_MODE_TIME + mode_number(ms) - 1] += best_h

@@ -1,0 +1,334 @@
+"""Closed-form integration of the non-rocking modes (1, 2, 4, 5), sample by sample.
+
+With the blocks at rest (theta = theta_dot = 0) the equations of motion of a mode are linear
+and homogeneous in the ground input (a, G = g + a_y): every acceleration and interface force is
+``w(a, G) = a w_a + G w_G`` with two response vectors fixed while the mode lasts. Between two
+samples a and G are linear in time, so within a sample interval
+
+* the forces, and with them every force-type event function (stick margins, the uplift
+  moment criterion, the normal forces), are linear in time, or the minimum of two linear
+  functions, and their roots are found exactly;
+* the slip velocities are quadratic in time and their zeros are found exactly;
+* displacements are cubic and the input power and friction dissipation rate are cubic, so the
+  state and the energy accounts advance exactly (Simpson's rule for the latter two).
+
+:func:`nonrocking_span` runs this loop over as many samples as the mode lasts without leaving
+compiled code or touching the general event machinery, which is what makes sliding and rest
+phases cheap (a few nanoseconds per sample at rest). It stops at the first event, leaving the
+state at the start of that sample interval and returning the event and its time within it; the
+general kernel then advances there and applies the event. The results agree with the general
+step-and-locate path to rounding: both integrate the same polynomials.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from shipblock.equations import (
+    I_FX,
+    I_FY,
+    I_SFX,
+    I_SFY,
+    I_XB_DD,
+    I_XS_DD,
+    kinetic_energy,
+    potential_energy,
+    solve_mode,
+)
+from shipblock.modes import MODE_NUMBER
+from shipblock.solver._events import event_functions
+from shipblock.solver._layout import (
+    EV_G_SLIP,
+    EV_G_STICK,
+    EV_IMPACT,
+    EV_OVERTURN,
+    EV_S_SLIP,
+    EV_S_STICK,
+    EV_SEP_G,
+    EV_SEP_S,
+    EV_UPLIFT,
+    EVENT_PRIORITY,
+    H_KIN,
+    H_POT,
+    MS_SIG1,
+    MS_SIG2,
+    MS_SLIP1,
+    MS_SLIP2,
+    N_EVENTS,
+    N_STATE,
+    REARM_TOL,
+    ROOT_TIME_TOL,
+    S_MODE_TIME,
+    Y_DIS,
+    Y_OM,
+    Y_TH,
+    Y_VB,
+    Y_VS,
+    Y_WIN,
+    Y_XB,
+    Y_XS,
+)
+from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
+
+NO_ROOT = math.inf
+
+
+@njit(cache=True, error_model="numpy")
+def linear_root(l0, l1, h):
+    """Time in [0, h] at which a linear function going from ``l0`` to ``l1`` turns negative.
+
+    ``inf`` if it ends non-negative; 0 if it starts on or below zero (the event is due now).
+    """
+    if l1 >= 0.0:
+        return NO_ROOT
+    if l0 <= 0.0:
+        return 0.0
+    return h * l0 / (l0 - l1)
+
+
+@njit(cache=True, error_model="numpy")
+def min_linear_root(la0, la1, lb0, lb1, h):
+    """As :func:`linear_root` for ``min(la, lb)`` of two linear functions (e.g. mu N - |T|).
+
+    The minimum of linear functions is concave, so it is negative inside the interval only if
+    it is negative at an end.
+    """
+    if min(la1, lb1) >= 0.0:
+        return NO_ROOT
+    if min(la0, lb0) <= 0.0:
+        return 0.0
+    return min(linear_root(la0, la1, h), linear_root(lb0, lb1, h))
+
+
+@njit(cache=True, error_model="numpy")
+def quadratic_root(q0, d0, c, h):
+    """First time in [0, h] at which ``q(s) = q0 + d0 s + c s^2`` crosses below zero.
+
+    ``inf`` if it does not. Starting on the boundary (``q0 <= 0``) the event is due at once
+    unless q rises first, in which case the root is where it comes back down.
+    """
+    q1 = q0 + h * (d0 + c * h)
+    if q0 <= 0.0:
+        if q1 >= 0.0:
+            return NO_ROOT  # leaves the boundary into the admissible side
+        if c >= 0.0:
+            return 0.0  # convex and non-positive at both ends: negative throughout
+    best = NO_ROOT
+    if c == 0.0:
+        if d0 < 0.0:
+            r = -q0 / d0
+            if 0.0 <= r <= h:
+                best = r
+    else:
+        disc = d0 * d0 - 4.0 * c * q0
+        if disc > 0.0:
+            qq = -0.5 * (d0 + math.copysign(math.sqrt(disc), d0))
+            r1 = qq / c
+            r2 = q0 / qq if qq != 0.0 else r1
+            # a down-crossing has q' = d0 + 2 c r < 0
+            if 0.0 <= r1 <= h and d0 + 2.0 * c * r1 < 0.0:
+                best = r1
+            if 0.0 <= r2 <= h and d0 + 2.0 * c * r2 < 0.0 and r2 < best:
+                best = r2
+    if q0 <= 0.0 and best == NO_ROOT:
+        return 0.0
+    return best
+
+
+@njit(cache=True, error_model="numpy")
+def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary, peaks,
+                    store, hist, modes, resp, g):
+    """Advance a non-rocking mode sample by sample until an event or the end of the record.
+
+    Parameters
+    ----------
+    p, ms, y : ndarray
+        Parameters, mode state and state (``y`` is updated in place).
+    k, tau : int, float
+        Current sample interval and time into it [s].
+    dt, ax, ay, has_ay, sh, sv
+        Record and scale factors as in :func:`shipblock.solver._kernel.run`.
+    armed : ndarray of bool
+        Events being watched; disarmed ones are re-armed once clear of zero.
+    summary : ndarray
+        Time in the mode is accumulated here.
+    peaks : ndarray, shape (2,)
+        Running peaks of |x_b| and |x_s| at the samples.
+    store, hist, modes
+        History output, as in ``run``: each sample the span completes is written.
+    resp : ndarray, shape (2, 7)
+        Work array for the response vectors.
+    g : ndarray, shape (N_EVENTS,)
+        Work array for the event functions.
+
+    Returns
+    -------
+    k, tau : int, float
+        Where the span stopped: the start of the sample interval holding the event, or the
+        end of the record.
+    event : int
+        The event (``EV_*``), -1 at the end of the record, -2 if the mode is singular.
+    h_event : float
+        Time of the event after ``tau`` [s].
+    """
+    n = ax.shape[0]
+    slip1, slip2 = ms[MS_SLIP1], ms[MS_SLIP2]
+    sig1, sig2 = float(ms[MS_SIG1]), float(ms[MS_SIG2])
+    wa = resp[0]
+    wg = resp[1]
+    ok_a = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
+    ok_g = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)
+    if not (ok_a and ok_g):
+        return k, tau, -2, 0.0
+    ub_a, us_a, fx_a, fy_a, Fx_a, Fy_a = wa[I_XB_DD], wa[I_XS_DD], wa[I_FX], wa[I_FY], wa[I_SFX], wa[I_SFY]
+    ub_g, us_g, fx_g, fy_g, Fx_g, Fy_g = wg[I_XB_DD], wg[I_XS_DD], wg[I_FX], wg[I_FY], wg[I_SFX], wg[I_SFY]
+    grav = p[P_G]
+    mus1, mus2, B, H = p[P_MUS1], p[P_MUS2], p[P_B], p[P_H]
+    M = p[P_M]
+    mass_b = p[P_NM] + M
+    inv_w = 1.0 / (mass_b * grav)
+    inv_ws = 1.0 / (M * grav)
+    inv_wr = inv_w / p[P_R]
+    mode_slot = S_MODE_TIME + MODE_NUMBER[slip1, 0, slip2] - 1
+    all_armed = True
+    for e in range(N_EVENTS):
+        if not armed[e]:
+            all_armed = False
+    # ground input at the start of the interval (interpolated when tau > 0, as ground_motion_at)
+    f = tau / dt
+    a0 = sh * ax[k]
+    a0 = a0 + (sh * ax[k + 1] - a0) * f
+    b0 = 0.0
+    if has_ay:
+        b0 = sv * ay[k]
+        b0 = b0 + (sv * ay[k + 1] - b0) * f
+    while k < n - 1:
+        h = dt - tau
+        a1 = sh * ax[k + 1]
+        b1 = sv * ay[k + 1] if has_ay else 0.0
+        G0 = grav + b0
+        G1 = grav + b1
+        fx0 = fx_a * a0 + fx_g * G0
+        fx1 = fx_a * a1 + fx_g * G1
+        fy0 = fy_a * a0 + fy_g * G0
+        fy1 = fy_a * a1 + fy_g * G1
+        Fx0 = Fx_a * a0 + Fx_g * G0
+        Fx1 = Fx_a * a1 + Fx_g * G1
+        Fy0 = Fy_a * a0 + Fy_g * G0
+        Fy1 = Fy_a * a1 + Fy_g * G1
+        ub0 = ub_a * a0 + ub_g * G0
+        ub1 = ub_a * a1 + ub_g * G1
+        us0 = us_a * a0 + us_g * G0
+        us1 = us_a * a1 + us_g * G1
+        vb0 = y[Y_VB]
+        vs0 = y[Y_VS]
+        # Cheap screen at the end of the interval: force-type event functions are linear (or
+        # concave) in time and can only fire if negative at the end; slip velocities are
+        # quadratic and can also dip below zero inside. Only a suspect interval is searched.
+        suspect = not all_armed or fy1 <= 0.0 or Fy1 <= 0.0 \
+            or B * (fy1 + Fy1) < H * abs(fx1 + Fx1)
+        if slip1:
+            cb = sig1 * (ub1 - ub0) / (2.0 * h)
+            suspect = suspect or sig1 * vb0 + h * (sig1 * ub0 + cb * h) < 0.0 \
+                or (sig1 * ub0 < 0.0 and sig1 * ub0 + 2.0 * cb * h > 0.0)
+        else:
+            suspect = suspect or mus1 * fy1 < abs(fx1)
+        if slip2:
+            cs = sig2 * (us1 - us0) / (2.0 * h)
+            suspect = suspect or sig2 * vs0 + h * (sig2 * us0 + cs * h) < 0.0 \
+                or (sig2 * us0 < 0.0 and sig2 * us0 + 2.0 * cs * h > 0.0)
+        else:
+            suspect = suspect or mus2 * Fy1 < abs(Fx1)
+        if suspect:
+            best_h = h + 1.0
+            best_e = -1
+            for ie in range(N_EVENTS):
+                e = EVENT_PRIORITY[ie]
+                # only the events a non-rocking mode can meet, and only armed ones
+                if not armed[e] or e in (EV_IMPACT, EV_OVERTURN) \
+                        or (e == EV_G_STICK and slip1) or (e == EV_G_SLIP and not slip1) \
+                        or (e == EV_S_STICK and slip2) or (e == EV_S_SLIP and not slip2):
+                    continue
+                if e == EV_SEP_G:
+                    r = linear_root(fy0 * inv_w, fy1 * inv_w, h)
+                elif e == EV_SEP_S:
+                    r = linear_root(Fy0 * inv_ws, Fy1 * inv_ws, h)
+                elif e == EV_G_STICK:
+                    r = min_linear_root((mus1 * fy0 - fx0) * inv_w, (mus1 * fy1 - fx1) * inv_w,
+                                        (mus1 * fy0 + fx0) * inv_w, (mus1 * fy1 + fx1) * inv_w,
+                                        h)
+                elif e == EV_S_STICK:
+                    r = min_linear_root((mus2 * Fy0 - Fx0) * inv_ws, (mus2 * Fy1 - Fx1) * inv_ws,
+                                        (mus2 * Fy0 + Fx0) * inv_ws, (mus2 * Fy1 + Fx1) * inv_ws,
+                                        h)
+                elif e == EV_UPLIFT:
+                    r = min_linear_root(
+                        (B * (fy0 + Fy0) - H * (fx0 + Fx0)) * inv_wr,
+                        (B * (fy1 + Fy1) - H * (fx1 + Fx1)) * inv_wr,
+                        (B * (fy0 + Fy0) + H * (fx0 + Fx0)) * inv_wr,
+                        (B * (fy1 + Fy1) + H * (fx1 + Fx1)) * inv_wr, h)
+                elif e == EV_G_SLIP:
+                    r = quadratic_root(sig1 * vb0, sig1 * ub0, sig1 * (ub1 - ub0) / (2.0 * h), h)
+                else:  # EV_S_SLIP
+                    r = quadratic_root(sig2 * vs0, sig2 * us0, sig2 * (us1 - us0) / (2.0 * h), h)
+                # a later-priority event wins only if it is clearly earlier (as in the kernel)
+                if r < best_h - 2.0 * ROOT_TIME_TOL:
+                    best_h = r
+                    best_e = e
+            if best_e >= 0:
+                return k, tau, best_e, best_h
+        # no event: advance exactly to the next sample
+        if slip1 or slip2 or vb0 != 0.0 or vs0 != 0.0:
+            vb1 = vb0 + 0.5 * h * (ub0 + ub1)
+            vs1 = vs0 + 0.5 * h * (us0 + us1)
+            vbm = vb0 + 0.5 * h * ub0 + 0.125 * h * (ub1 - ub0)
+            vsm = vs0 + 0.5 * h * us0 + 0.125 * h * (us1 - us0)
+            am = 0.5 * (a0 + a1)
+            # input power -a P_x and friction dissipation -(fx vb + Fx vs), cubic: Simpson
+            r0 = -a0 * (mass_b * vb0 + M * vs0)
+            rm = -am * (mass_b * vbm + M * vsm)
+            r1 = -a1 * (mass_b * vb1 + M * vs1)
+            d0 = -(fx0 * vb0 + Fx0 * vs0)
+            dm = -(0.5 * (fx0 + fx1) * vbm + 0.5 * (Fx0 + Fx1) * vsm)
+            d1 = -(fx1 * vb1 + Fx1 * vs1)
+            y[Y_XB] += h * vb0 + h * h * (2.0 * ub0 + ub1) / 6.0
+            y[Y_XS] += h * vs0 + h * h * (2.0 * us0 + us1) / 6.0
+            y[Y_VB] = vb1
+            y[Y_VS] = vs1
+            y[Y_WIN] += h * (r0 + 4.0 * rm + r1) / 6.0
+            y[Y_DIS] += h * (d0 + 4.0 * dm + d1) / 6.0
+        summary[mode_slot] += h
+        k += 1
+        tau = 0.0
+        a0 = a1
+        b0 = b1
+        axb = abs(y[Y_XB])
+        if axb > peaks[0]:
+            peaks[0] = axb
+        axs = abs(y[Y_XS])
+        if axs > peaks[1]:
+            peaks[1] = axs
+        if not all_armed:
+            event_functions(p, ms, y, fx1, fy1, Fx1, Fy1, g)
+            all_armed = True
+            for e in range(N_EVENTS):
+                if not armed[e]:
+                    if g[e] > REARM_TOL:
+                        armed[e] = True
+                    else:
+                        all_armed = False
+        if store:
+            _store(p, y, hist, modes, k, MODE_NUMBER[slip1, 0, slip2])
+    return k, tau, -1, 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _store(p, y, hist, modes, k, mode):
+    """History row of a non-rocking sample: the state, its energies and the mode."""
+    for i in range(N_STATE):
+        hist[k, i] = y[i]
+    hist[k, H_KIN] = kinetic_energy(p, y[Y_TH], 1.0, 0, y[Y_VB], y[Y_OM], y[Y_VS])
+    hist[k, H_POT] = potential_energy(p, y[Y_TH])
+    modes[k] = mode

@@ -1,0 +1,61 @@
+"""Event functions of the solver: one per constraint of the current mode (compiled).
+
+Each function is >= 0 while its constraint holds and is scaled to be dimensionless
+(forces by the weights, moments by weight x R); see ``EV_*`` in
+:mod:`shipblock.solver._layout`. Constraints that do not apply to the mode are set to 1.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from shipblock.solver._layout import (
+    EV_G_SLIP,
+    EV_G_STICK,
+    EV_IMPACT,
+    EV_OVERTURN,
+    EV_S_SLIP,
+    EV_S_STICK,
+    EV_SEP_G,
+    EV_SEP_S,
+    EV_UPLIFT,
+    MS_ROCK,
+    MS_S,
+    MS_SIG1,
+    MS_SIG2,
+    MS_SLIP1,
+    MS_SLIP2,
+    N_EVENTS,
+    Y_TH,
+    Y_VB,
+    Y_VS,
+)
+from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R, P_THC
+
+
+@njit(cache=True)
+def event_functions(p, ms, y, fx, fy, Fx, Fy, g):
+    """Fill ``g`` with the event functions of mode ``ms`` at state ``y`` and interface forces.
+
+    ``(fx, fy)`` is the force of the ground on the blocks and ``(Fx, Fy)`` that of the blocks
+    on the ship [N] (totals over the n blocks).
+    """
+    weight = (p[P_NM] + p[P_M]) * p[P_G]
+    ship_weight = p[P_M] * p[P_G]
+    for e in range(N_EVENTS):
+        g[e] = 1.0
+    if ms[MS_SLIP1]:
+        g[EV_G_SLIP] = ms[MS_SIG1] * y[Y_VB]
+    else:
+        g[EV_G_STICK] = (p[P_MUS1] * fy - abs(fx)) / weight
+    if ms[MS_ROCK]:
+        g[EV_IMPACT] = ms[MS_S] * y[Y_TH]
+        g[EV_OVERTURN] = p[P_THC] - ms[MS_S] * y[Y_TH]
+    else:
+        g[EV_UPLIFT] = (p[P_B] * (fy + Fy) - p[P_H] * abs(fx + Fx)) / (weight * p[P_R])
+    if ms[MS_SLIP2]:
+        g[EV_S_SLIP] = ms[MS_SIG2] * y[Y_VS]
+    else:
+        g[EV_S_STICK] = (p[P_MUS2] * Fy - abs(Fx)) / ship_weight
+    g[EV_SEP_G] = fy / weight
+    g[EV_SEP_S] = Fy / ship_weight

@@ -1,0 +1,137 @@
+"""Interpolants over one accepted rocking step (compiled).
+
+A Dormand-Prince step gives the rotation ``theta``, its rate and its acceleration at both
+ends of the step (the acceleration at the end is the last, first-same-as-last stage). The
+quintic Hermite interpolant through these six values is accurate to O(h^6), far below the
+step's own error tolerance, and costs no evaluation of the equations of motion. The solver
+uses it to place peak rotations (where ``theta_dot`` changes sign) and as the first guess
+when it locates an impact (``theta = 0``), which it then confirms on the integrated state.
+
+With ``u = (t - t_0) / h`` the interpolant is ``p(u) = sum c_i u^i`` with
+
+.. math::
+
+    c_0 &= \\theta_0, \\quad c_1 = h\\dot\\theta_0, \\quad c_2 = h^2\\ddot\\theta_0 / 2, \\\\
+    c_3 &= 10(\\theta_1 - \\theta_0) - h(6\\dot\\theta_0 + 4\\dot\\theta_1)
+          - h^2(3\\ddot\\theta_0 - \\ddot\\theta_1)/2, \\\\
+    c_4 &= 15(\\theta_0 - \\theta_1) + h(8\\dot\\theta_0 + 7\\dot\\theta_1)
+          + h^2(3\\ddot\\theta_0/2 - \\ddot\\theta_1), \\\\
+    c_5 &= 6(\\theta_1 - \\theta_0) - 3h(\\dot\\theta_0 + \\dot\\theta_1)
+          + h^2(\\ddot\\theta_1 - \\ddot\\theta_0)/2
+
+(checked symbolically in ``tests/test_interpolate.py``).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+
+@njit(cache=True)
+def quintic_hermite(th0, om0, al0, th1, om1, al1, h):
+    """Monomial coefficients ``(c0, ..., c5)`` of the quintic Hermite interpolant on u in [0, 1]."""
+    d = th1 - th0
+    h2 = h * h
+    c3 = 10.0 * d - h * (6.0 * om0 + 4.0 * om1) - h2 * (1.5 * al0 - 0.5 * al1)
+    c4 = -15.0 * d + h * (8.0 * om0 + 7.0 * om1) + h2 * (1.5 * al0 - al1)
+    c5 = 6.0 * d - 3.0 * h * (om0 + om1) + 0.5 * h2 * (al1 - al0)
+    return th0, h * om0, 0.5 * h2 * al0, c3, c4, c5
+
+
+@njit(cache=True)
+def poly5(c0, c1, c2, c3, c4, c5, u):
+    """Value of the quintic at ``u`` (Horner)."""
+    return c0 + u * (c1 + u * (c2 + u * (c3 + u * (c4 + u * c5))))
+
+
+@njit(cache=True)
+def poly5_slope(c1, c2, c3, c4, c5, u):
+    """Derivative of the quintic with respect to ``u``."""
+    return c1 + u * (2.0 * c2 + u * (3.0 * c3 + u * (4.0 * c4 + u * 5.0 * c5)))
+
+
+@njit(cache=True)
+def poly5_curvature(c2, c3, c4, c5, u):
+    """Second derivative of the quintic with respect to ``u``."""
+    return 2.0 * c2 + u * (6.0 * c3 + u * (12.0 * c4 + u * 20.0 * c5))
+
+
+@njit(cache=True)
+def bracketed_root(c0, c1, c2, c3, c4, c5, lo, hi, derivative):
+    """Root in ``[lo, hi]`` of the quintic (or of its derivative) that changes sign there.
+
+    Safeguarded Newton: a Newton step that leaves the bracket is replaced by bisection, so it
+    converges for any sign-changing bracket. Returns -1 when the ends have the same sign.
+    """
+    if derivative:
+        f_lo = poly5_slope(c1, c2, c3, c4, c5, lo)
+        f_hi = poly5_slope(c1, c2, c3, c4, c5, hi)
+    else:
+        f_lo = poly5(c0, c1, c2, c3, c4, c5, lo)
+        f_hi = poly5(c0, c1, c2, c3, c4, c5, hi)
+    if f_lo == 0.0:
+        return lo
+    if f_hi == 0.0:
+        return hi
+    if (f_lo > 0.0) == (f_hi > 0.0):
+        return -1.0
+    rising = f_hi > 0.0
+    u = lo - f_lo * (hi - lo) / (f_hi - f_lo)
+    for _ in range(60):
+        if derivative:
+            f = poly5_slope(c1, c2, c3, c4, c5, u)
+            df = poly5_curvature(c2, c3, c4, c5, u)
+        else:
+            f = poly5(c0, c1, c2, c3, c4, c5, u)
+            df = poly5_slope(c1, c2, c3, c4, c5, u)
+        if f == 0.0:
+            return u
+        if (f > 0.0) == rising:
+            hi = u
+        else:
+            lo = u
+        step = f / df if df != 0.0 else math.inf
+        un = u - step
+        if not (lo < un < hi):
+            un = 0.5 * (lo + hi)
+        if abs(un - u) <= 1e-15 * max(1.0, abs(u)) or hi - lo <= 1e-15:
+            return un
+        u = un
+    return u
+
+
+@njit(cache=True)
+def hermite_extremum(g0, d0, g1, d1):
+    """Interior extremum of the cubic Hermite interpolant on [0, 1]: (u, value) or (-1, 0).
+
+    ``d0`` and ``d1`` are the end slopes scaled to the unit interval. Used to look for a
+    velocity-type event function dipping below zero inside a step.
+    """
+    # p(u) = g0 + d0 u + c2 u^2 + c3 u^3
+    c2 = 3.0 * (g1 - g0) - 2.0 * d0 - d1
+    c3 = 2.0 * (g0 - g1) + d0 + d1
+    # p'(u) = d0 + 2 c2 u + 3 c3 u^2
+    qa, qb, qc = 3.0 * c3, 2.0 * c2, d0
+    best_u = -1.0
+    best_v = 0.0
+    if abs(qa) < 1e-300:
+        if qb != 0.0:
+            u = -qc / qb
+            if 0.0 < u < 1.0:
+                best_u = u
+    else:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc >= 0.0:
+            sq = math.sqrt(disc)
+            for u in ((-qb - sq) / (2.0 * qa), (-qb + sq) / (2.0 * qa)):
+                if 0.0 < u < 1.0:
+                    v = g0 + d0 * u + c2 * u * u + c3 * u * u * u
+                    if best_u < 0.0 or (d0 < 0.0 and v < best_v) or (d0 > 0.0 and v > best_v):
+                        best_u = u
+                        best_v = v
+    if best_u >= 0.0:
+        u = best_u
+        best_v = g0 + d0 * u + c2 * u * u + c3 * u * u * u
+    return best_u, best_v

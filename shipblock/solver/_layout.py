@@ -1,0 +1,72 @@
+"""Layout of the solver's arrays: state, mode state, events, summary; numerical constants.
+
+Shared by the compiled kernels (:mod:`shipblock.solver._kernel` and
+:mod:`shipblock.solver._closed_form`) and the Python wrappers that read their outputs.
+"""
+
+import numpy as np
+
+# State vector.
+Y_XB, Y_TH, Y_XS, Y_VB, Y_OM, Y_VS, Y_WIN, Y_DIS, Y_IMP = 0, 1, 2, 3, 4, 5, 6, 7, 8
+N_STATE = 9  # the last three accumulate input work, friction dissipation and impact loss [J]
+N_DYN = 6  # components under error control
+# Extra columns of the stored history: kinetic and potential energy at the samples [J].
+H_KIN, H_POT = N_STATE, N_STATE + 1
+N_HIST = N_STATE + 2
+
+# Mode state vector: interface flags and signs.
+MS_SLIP1, MS_ROCK, MS_SLIP2, MS_S, MS_SIG1, MS_SIG2 = 0, 1, 2, 3, 4, 5
+
+# Event functions; each is >= 0 while its constraint holds.
+EV_G_STICK = 0  # blocks stick on the ground: mu_s1 fy - |fx|
+EV_G_SLIP = 1  # blocks slide: sigma1 * v_b
+EV_UPLIFT = 2  # blocks at rest: B (fy + Fy) - H |fx + Fx|
+EV_IMPACT = 3  # rocking: s * theta
+EV_OVERTURN = 4  # rocking: theta_c - s * theta
+EV_S_STICK = 5  # ship sticks: mu_s2 Fy - |Fx|
+EV_S_SLIP = 6  # ship slides: sigma2 * v_s
+EV_SEP_G = 7  # fy > 0
+EV_SEP_S = 8  # Fy > 0
+N_EVENTS = 9
+EV_ROTATION_PEAK = 9  # not a transition: theta_dot changes sign (locates peak rotations)
+#: Order in which simultaneous events are taken: failures first, then velocity events.
+EVENT_PRIORITY = np.array(
+    [EV_SEP_G, EV_SEP_S, EV_OVERTURN, EV_IMPACT, EV_G_SLIP, EV_S_SLIP, EV_UPLIFT, EV_G_STICK,
+     EV_S_STICK],
+    dtype=np.int64,
+)
+
+# Summary vector of one run.
+S_PEAK_XB = 0
+S_PEAK_TH = 1
+S_PEAK_XS = 2
+S_RES_XB = 3
+S_RES_XS = 4
+S_UPLIFT = 5
+S_N_IMPACTS = 6
+S_FAILURE = 7
+S_FAILURE_TIME = 8
+S_MODE_TIME = 9  # 8 entries, modes 1..8
+S_END_TIME = 17
+S_N_EVENTS = 18
+S_W_IN = 19
+S_DISSIPATED = 20
+S_IMPACT_LOSS = 21
+S_N_FALLBACK = 22
+S_ENERGY_FINAL = 23  # T + V at the end
+S_PEAK_TH_TIME = 24
+N_SUMMARY = 25
+
+# Numerical constants (documented in docs/theory/solver.md).
+ROOT_TIME_TOL = 1e-12  # [s] width of the bracket that locates an event
+GUESS_PROBE = 1e-11  # [s] offset of the second trial after an interpolated first guess
+ONE_SIDED_DT = 1e-8  # [s] candidate modes are checked this long after an event
+FORCE_TOL = 1e-10  # [-] tolerance on force margins, relative to the weight
+ACC_TOL = 1e-10  # [-] a new motion must accelerate by more than this times g
+REARM_TOL = 1e-9  # [-] a disarmed event is re-armed once its function exceeds this
+MAX_STEP_SAMPLES = 1.0  # [-] longest rocking step, in input samples (see docs/theory/solver)
+MIN_STEP = 1e-13  # [s] smallest rocking step before the run is declared failed
+MAX_EVENTS_PER_SAMPLE = 20000  # guards against chattering
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 5.0
