@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,6 +29,44 @@ class Event:
     kind: str
     from_mode: int
     to_mode: int
+
+
+class EventLog(Sequence):
+    """The located events of a run, as a read-only sequence of :class:`Event`.
+
+    Holds the kernel's event arrays and builds an :class:`Event` only when one is looked at,
+    so runs with thousands of stick-slip events cost no Python objects until they are used.
+
+    Parameters
+    ----------
+    time : ndarray
+        Event times [s].
+    kind, from_mode, to_mode : ndarray of int
+        Event codes (:class:`~shipblock.modes.EventKind`) and modes before and after.
+    """
+
+    def __init__(self, time, kind, from_mode, to_mode):
+        self.time = np.asarray(time, dtype=float)
+        self.kind_code = np.asarray(kind, dtype=np.int64)
+        self.from_mode = np.asarray(from_mode, dtype=np.int64)
+        self.to_mode = np.asarray(to_mode, dtype=np.int64)
+
+    def __len__(self) -> int:
+        return self.time.size
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        return Event(float(self.time[index]), _KIND_NAMES[int(self.kind_code[index])],
+                     int(self.from_mode[index]), int(self.to_mode[index]))
+
+    @property
+    def kinds(self) -> np.ndarray:
+        """Event kind names as an array of str."""
+        return np.array([_KIND_NAMES[int(k)] for k in self.kind_code], dtype=str)
+
+    def __repr__(self) -> str:
+        return f"EventLog({list(self)!r})"
 
 
 @dataclass(frozen=True)
@@ -82,8 +121,8 @@ class SimulationResult:
         Their rates [m/s, rad/s, m/s].
     mode : ndarray of int
         Active mode (paper numbering 1..8) at each sample.
-    events : list of Event
-        Every located event, in time order (the first is the start).
+    events : sequence of Event
+        Every located event, in time order (the first is the start); an :class:`EventLog`.
     failure : str or None
         ``None``, ``"separation"``, ``"overturning"`` or ``"solver_error"``.
     failure_time : float or None
@@ -106,7 +145,7 @@ class SimulationResult:
     theta_dot: np.ndarray
     v_s: np.ndarray
     mode: np.ndarray
-    events: list
+    events: Sequence
     failure: str | None
     failure_time: float | None
     energy: Energy
@@ -141,6 +180,7 @@ class SimulationResult:
             return xr.Variable(dims, values, attrs={"units": units, "long_name": long_name})
 
         ax, ay = self.ground_acceleration
+        events = self.events
         ds = xr.Dataset(
             {
                 "ground_acceleration_h": var(ax, "m/s^2", "horizontal ground acceleration"),
@@ -157,10 +197,14 @@ class SimulationResult:
                 "potential_energy": var(self.energy.potential, "J", "gravity potential energy"),
                 "friction_dissipation": var(self.energy.friction, "J", "energy dissipated by friction"),
                 "impact_loss": var(self.energy.impact, "J", "kinetic energy lost in impacts"),
-                "event_time": var(np.array([e.time for e in self.events]), "s", "event time", ("event",)),
-                "event_kind": var(np.array([e.kind for e in self.events], dtype=str), "1", "event kind", ("event",)),
-                "event_from_mode": var(np.array([e.from_mode for e in self.events], dtype=np.int8), "1", "mode before the event", ("event",)),
-                "event_to_mode": var(np.array([e.to_mode for e in self.events], dtype=np.int8), "1", "mode after the event", ("event",)),
+                "event_time": var(np.array([e.time for e in events], dtype=float), "s",
+                                  "event time", ("event",)),
+                "event_kind": var(np.array([e.kind for e in events], dtype=str), "1",
+                                  "event kind", ("event",)),
+                "event_from_mode": var(np.array([e.from_mode for e in events], dtype=np.int8),
+                                       "1", "mode before the event", ("event",)),
+                "event_to_mode": var(np.array([e.to_mode for e in events], dtype=np.int8), "1",
+                                     "mode after the event", ("event",)),
             },
             coords={"time": ("time", self.time, {"units": "s", "long_name": "time"})},
         )
@@ -183,9 +227,12 @@ class SimulationResult:
         return ds
 
 
+_KIND_NAMES = {k.value: k.name.lower() for k in EventKind}
+
+
 def event_kind_name(code: int) -> str:
     """Lower-case name of an event code."""
-    return EventKind(int(code)).name.lower()
+    return _KIND_NAMES[int(code)]
 
 
 def failure_name(code: int) -> str | None:

@@ -203,3 +203,23 @@ def test_sliding_mirror_symmetry():
     np.testing.assert_allclose(r_neg.x_s, -r_pos.x_s, atol=1e-12)
     np.testing.assert_array_equal(r_neg.mode, r_pos.mode)
     assert np.abs(r_pos.x_b).max() > 0.01
+
+
+def test_event_log_is_a_sequence_of_events_and_reaches_the_dataset():
+    """The lazily built event log behaves as a list of Event, and to_dataset carries it."""
+    from shipblock.result import Event
+
+    system = ShipBlockSystem(ship_mass=2e6, block_mass=1500.0, n_blocks=100, half_width=2.0,
+                             half_height=0.5, mu_s_ground=0.1, mu_k_ground=0.1, mu_s_ship=0.8,
+                             mu_k_ship=0.8)
+    t = np.arange(0, 4, 0.01)
+    res = simulate(system, 2.0 * np.sin(2 * np.pi * t), None, 0.01)
+    events = list(res.events)
+    assert len(events) == len(res.events) > 3
+    assert all(isinstance(e, Event) for e in events)
+    assert res.events[-1] == events[-1] and res.events[1:3] == events[1:3]
+    assert [e.time for e in events] == sorted(e.time for e in events)
+    assert {e.kind for e in events} >= {"start", "ground_slip_start", "ground_slip_stop"}
+    ds = res.to_dataset()
+    np.testing.assert_array_equal(ds["event_time"].values, [e.time for e in events])
+    assert list(ds["event_kind"].values) == [e.kind for e in events]

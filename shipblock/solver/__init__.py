@@ -13,7 +13,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from shipblock.result import Energy, Event, SimulationResult, event_kind_name, failure_name
+from shipblock.result import Energy, EventLog, SimulationResult, failure_name
 from shipblock.solver import _kernel as K
 from shipblock.system import P_THC, ShipBlockSystem
 
@@ -178,10 +178,7 @@ def simulate(
         friction=hist[:, K.Y_DIS].copy(),
         impact=hist[:, K.Y_IMP].copy(),
     )
-    events = [
-        Event(float(t), event_kind_name(k), int(f), int(to))
-        for t, k, f, to in zip(ev_t, ev_k, ev_f, ev_to, strict=True)
-    ]
+    events = EventLog(ev_t, ev_k, ev_f, ev_to)
     summ = _summary_dict(summary, system)
     if summ["n_mode_fallbacks"] > 0:
         warnings.warn(
