@@ -389,3 +389,13 @@ def test_peak_rotation_and_its_time_from_energy(ship_mass, n):
     assert res.summary["peak_rotation"] == pytest.approx(theta_max, rel=1e-9)
     assert res.summary["peak_rotation_time"] == pytest.approx(t_peak, abs=1e-8)
     assert abs(res.theta).max() < theta_max  # the samples miss the peak itself
+
+
+def test_parameter_tuple_carries_the_whole_parameter_vector():
+    """The kernels index the parameters as a tuple; it must hold every entry of the vector."""
+    from shipblock.solver._layout import parameter_tuple
+    from shipblock.system import N_PARAMS
+
+    p = all_modes_system().to_parameter_vector()
+    assert p.size == N_PARAMS
+    assert parameter_tuple(p) == tuple(p)

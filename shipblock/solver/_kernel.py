@@ -43,6 +43,7 @@ from shipblock.solver._interpolate import (
     quintic_hermite,
 )
 from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrappers)
+    parameter_tuple,
     ACC_TOL,
     EV_G_SLIP,
     EV_G_STICK,
@@ -131,24 +132,24 @@ def ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt):
 
 
 @njit(cache=True)
-def rhs(p, ms, y, a, ay, dy, w7):
-    """Time derivative of the state in the mode ``ms``; returns False if singular."""
+def rhs(p, ms, y, a, ay, stages, st, w7):
+    """Time derivative of the state in the mode ``ms`` into ``stages[st]``; False if singular."""
     rock = ms[MS_ROCK]
     ok = solve_mode(
         p, ms[MS_SLIP1], rock, ms[MS_SLIP2], float(ms[MS_S]), float(ms[MS_SIG1]),
         float(ms[MS_SIG2]), y[Y_TH], y[Y_OM], a, p[P_G] + ay, w7,
     )
-    dy[Y_XB] = y[Y_VB]
-    dy[Y_TH] = y[Y_OM]
-    dy[Y_XS] = y[Y_VS]
-    dy[Y_VB] = w7[0]
-    dy[Y_OM] = w7[1]
-    dy[Y_VS] = w7[2]
-    dy[Y_WIN] = input_power(
+    stages[st, Y_XB] = y[Y_VB]
+    stages[st, Y_TH] = y[Y_OM]
+    stages[st, Y_XS] = y[Y_VS]
+    stages[st, Y_VB] = w7[0]
+    stages[st, Y_OM] = w7[1]
+    stages[st, Y_VS] = w7[2]
+    stages[st, Y_WIN] = input_power(
         p, y[Y_TH], float(ms[MS_S]), rock, y[Y_VB], y[Y_OM], y[Y_VS], a, ay
     )
-    dy[Y_DIS] = -(w7[I_FX] * y[Y_VB] + w7[I_SFX] * y[Y_VS])
-    dy[Y_IMP] = 0.0
+    stages[st, Y_DIS] = -(w7[I_FX] * y[Y_VB] + w7[I_SFX] * y[Y_VS])
+    stages[st, Y_IMP] = 0.0
     return ok
 
 
@@ -230,6 +231,12 @@ def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, 
         return 0.0
     if ms[MS_ROCK] == 0:
         return advance_polynomial(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages)
+    # the step stays within sample interval k, where the input is linear in time
+    # (the same arithmetic as ground_motion_at)
+    a0 = sh * ax[k]
+    a1 = sh * ax[k + 1]
+    b0 = sv * ay[k] if has_ay else 0.0
+    b1 = sv * ay[k + 1] if has_ay else 0.0
     for st in range(7):
         if st == 0 and first_stage_known:
             continue
@@ -238,8 +245,8 @@ def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, 
             for j in range(st):
                 acc += h * DP_A[st, j] * stages[j, i]
             ytmp[i] = acc
-        a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + DP_C[st] * h, dt)
-        if not rhs(p, ms, ytmp, a, b, stages[st], w7):
+        f = (tau + DP_C[st] * h) / dt
+        if not rhs(p, ms, ytmp, a0 + (a1 - a0) * f, b0 + (b1 - b0) * f, stages, st, w7):
             return -1.0
     for i in range(n):
         y1[i] = ytmp[i]  # the 7th stage point is the 5th-order solution (FSAL)
@@ -548,13 +555,15 @@ def _grow(arr_t, arr_k, arr_f, arr_to, n):
 
 
 @njit(cache=True)
-def run(p, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes, summary, y_init):
+def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes, summary,
+        y_init):
     """Integrate one record.
 
     Parameters
     ----------
-    p : ndarray
-        Parameter vector.
+    p_vec : ndarray
+        Parameter vector (used as a tuple inside: a tuple is passed by value, with no
+        reference count for parallel runs to contend on).
     ax, ay : ndarray
         Horizontal and vertical ground acceleration at the samples [m/s^2] (``ay`` ignored
         unless ``has_ay``).
@@ -580,6 +589,7 @@ def run(p, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, mode
     ev_time, ev_kind, ev_from, ev_to : ndarray
         The event log (only filled when ``store``).
     """
+    p = parameter_tuple(p_vec)
     n = ax.shape[0]
     y = np.zeros(N_STATE)
     y1 = np.zeros(N_STATE)
@@ -921,13 +931,19 @@ def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params
     ``offsets[r]:offsets[r+1]``. Only summaries are produced.
     """
     n_cases = case_record.shape[0]
-    empty_hist = np.zeros((0, N_HIST))
-    empty_modes = np.zeros(0, dtype=np.int64)
-    at_rest = np.zeros(N_DYN)
     for c in prange(n_cases):
         r = case_record[c]
         a0 = offsets[r]
         a1 = offsets[r + 1]
-        run(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
-            case_sv[c], dts[r], rtol, atol, zeno_omega, False, empty_hist, empty_modes,
-            summaries[c], at_rest)
+        # Private copies of everything the run touches: arrays shared between threads would
+        # have their reference counts updated atomically by every thread on every call down
+        # the kernel's call tree, and that contended cache line costs more than the copies.
+        p_c = params[case_params[c]].copy()
+        h_c = acc_h[a0:a1].copy()
+        v_c = acc_v[a0:a1].copy() if has_v[r] else h_c  # not read without a vertical record
+        summary_c = np.empty(N_SUMMARY)
+        run(p_c, h_c, v_c, has_v[r], case_sh[c], case_sv[c], dts[r], rtol, atol, zeno_omega,
+            False, np.zeros((0, N_HIST)), np.zeros(0, dtype=np.int64), summary_c,
+            np.zeros(N_DYN))
+        for i in range(N_SUMMARY):
+            summaries[c, i] = summary_c[i]

@@ -5,6 +5,7 @@ Shared by the compiled kernels (:mod:`shipblock.solver._kernel` and
 """
 
 import numpy as np
+from numba import njit
 
 # State vector.
 Y_XB, Y_TH, Y_XS, Y_VB, Y_OM, Y_VS, Y_WIN, Y_DIS, Y_IMP = 0, 1, 2, 3, 4, 5, 6, 7, 8
@@ -70,3 +71,10 @@ MAX_EVENTS_PER_SAMPLE = 20000  # guards against chattering
 SAFETY = 0.9
 MIN_FACTOR = 0.2
 MAX_FACTOR = 5.0
+
+
+@njit(cache=True)
+def parameter_tuple(p):
+    """The parameter vector as a tuple (see ``shipblock.system.P_*``, 14 entries)."""
+    return (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11], p[12],
+            p[13])
