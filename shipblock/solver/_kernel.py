@@ -43,7 +43,6 @@ from shipblock.solver._interpolate import (
     quintic_hermite,
 )
 from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrappers)
-    parameter_tuple,
     ACC_TOL,
     EV_G_SLIP,
     EV_G_STICK,
@@ -106,6 +105,7 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     Y_WIN,
     Y_XB,
     Y_XS,
+    parameter_tuple,
 )
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
@@ -396,6 +396,22 @@ def rotation_extremum(y0, y1, al0, al1, h):
 
 
 @njit(cache=True)
+def interface_option(v, i):
+    """Option ``i`` (0..2) of an interface whose motion has velocity ``v``: (flag, sign, new).
+
+    A moving interface (``v != 0``) has one option, moving on in its direction. One at rest
+    may stay (flag 0), or start moving either way (flag 1, sign +1 or -1; ``new`` = 1).
+    Returns flag -1 for an option that does not exist.
+    """
+    if v != 0.0:
+        if i > 0:
+            return -1, 0, 0
+        return 1, (1 if v > 0.0 else -1), 0
+    flag = 0 if i == 0 else 1
+    return flag, (-1 if i == 2 else 1), flag
+
+
+@njit(cache=True)
 def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
     """Choose the next mode among the candidates consistent with the velocities.
 
@@ -432,39 +448,19 @@ def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
     # holding a consistent candidate (usually the first: nothing new starts). The fallback
     # (no consistent candidate) has then compared the violations of all of them.
     for level in range(4):
-        # option lists: (flag, sign)
         for i1 in range(3):
-            if vb != 0.0:
-                if i1 > 0:
-                    continue
-                slip1, sig1 = 1, (1 if vb > 0.0 else -1)
-                new1 = 0
-            else:
-                slip1 = 0 if i1 == 0 else 1
-                sig1 = -1 if i1 == 2 else 1
-                new1 = slip1
+            slip1, sig1, new1 = interface_option(vb, i1)
+            if slip1 < 0:
+                continue
             for ir in range(3):
-                if th != 0.0 or om != 0.0:
-                    if ir > 0:
-                        continue
-                    rock = 1
-                    ref = th if th != 0.0 else om
-                    s = 1 if ref > 0.0 else -1
-                    newr = 0
-                else:
-                    rock = 0 if ir == 0 else 1
-                    s = -1 if ir == 2 else 1
-                    newr = rock
+                # the pivot follows theta, or theta_dot at theta = 0 (just after an impact)
+                rock, s, newr = interface_option(th if th != 0.0 else om, ir)
+                if rock < 0:
+                    continue
                 for i2 in range(3):
-                    if vs != 0.0:
-                        if i2 > 0:
-                            continue
-                        slip2, sig2 = 1, (1 if vs > 0.0 else -1)
-                        new2 = 0
-                    else:
-                        slip2 = 0 if i2 == 0 else 1
-                        sig2 = -1 if i2 == 2 else 1
-                        new2 = slip2
+                    slip2, sig2, new2 = interface_option(vs, i2)
+                    if slip2 < 0:
+                        continue
                     if new1 + newr + new2 != level:
                         continue
                     ok = solve_mode(p, slip1, rock, slip2, float(s), float(sig1), float(sig2),
@@ -862,7 +858,8 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
             if events_here > MAX_EVENTS_PER_SAMPLE and failure == 0:
                 failure = Failure.SOLVER_ERROR
                 failure_time = t_now
-            if failure == 0:
+            if failure == 0 and ms[MS_ROCK]:
+                # the rocking steps compare with these; the closed-form span finds its own
                 event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g0, w7)
         # peaks
         axb = abs(y[Y_XB])
