@@ -66,7 +66,7 @@ N_SOLVE_OUT = 7
 SINGULAR_RELATIVE = 1e-12
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def pivot_geometry(p, theta, s, rock):
     """Return ``(c, sn)`` = (cos phi, sin phi) with phi = theta_c - s*theta.
 
@@ -78,7 +78,7 @@ def pivot_geometry(p, theta, s, rock):
     return p[P_H] / p[P_R], p[P_B] / p[P_R]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def solve_mode(p, slip1, rock, slip2, s, sig1, sig2, theta, omega, a, G, out):
     """Accelerations and interface forces in the mode given by three interface flags.
 
@@ -218,7 +218,7 @@ def potential_energy(p, theta):
     return (p[P_NM] + 2.0 * p[P_M]) * p[P_G] * p[P_R] * (math.cos(phi) - math.cos(p[P_THC]))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def input_power(p, theta, s, rock, vb, om, vs, a, ay):
     """Power of the inertial forces of the ground motion, -a P_x - ay P_y [W].
 

@@ -33,7 +33,7 @@ from shipblock.solver._layout import (
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R, P_THC
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def event_functions(p, ms, y, fx, fy, Fx, Fy, g):
     """Fill ``g`` with the event functions of mode ``ms`` at state ``y`` and interface forces.
 

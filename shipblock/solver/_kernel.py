@@ -131,7 +131,7 @@ def ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt):
     return a, b
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def rhs(p, ms, y, a, ay, stages, st, w7):
     """Time derivative of the state in the mode ``ms`` into ``stages[st]``; False if singular."""
     rock = ms[MS_ROCK]
@@ -213,7 +213,7 @@ def advance_polynomial(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, sta
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
             first_stage_known=False):
     """Advance ``y0`` by ``h`` within sample interval ``k``; returns 0, or -1 if singular.
@@ -253,7 +253,7 @@ def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, 
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def error_norm(y0, y1, stages, h, rtol, atol):
     """RMS of the embedded error estimate scaled by atol + rtol*|y| over the dynamic states."""
     acc = 0.0
