@@ -345,7 +345,13 @@ def cmd_plot(args):
 def cmd_bench(args):
     from shipblock.bench import run_benchmarks
 
-    return run_benchmarks(quick=args.quick, pyslammer=not args.no_pyslammer, output=args.output)
+    if args.campaign_runs is not None and args.campaign_runs < 0:
+        raise UserError(f"--campaign-runs must be >= 0, got {args.campaign_runs}")
+    if args.chunk_size is not None and args.chunk_size < 1:
+        raise UserError(f"--chunk-size must be >= 1, got {args.chunk_size}")
+    return run_benchmarks(quick=args.quick, pyslammer=not args.no_pyslammer, output=args.output,
+                          campaign_runs=args.campaign_runs, chunk_size=args.chunk_size,
+                          profile=args.profile)
 
 
 # --------------------------------------------------------------------------- parser
@@ -401,10 +407,18 @@ def build_parser():
     s.add_argument("--edp", default="peak_ship_slip", help="demand parameter of the IDA curves")
     s.set_defaults(func=cmd_plot)
 
-    s = sub.add_parser("bench", help="benchmarks: samples/s, pySLAMMER comparison, batch scaling")
-    s.add_argument("--quick", action="store_true", help="smaller, faster benchmark")
+    s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "
+                                     "batch scaling")
+    s.add_argument("--quick", action="store_true",
+                   help="smaller, faster benchmark (campaign of 300 runs)")
     s.add_argument("--no-pyslammer", action="store_true", help="skip the pySLAMMER comparison")
     s.add_argument("--output", "-o", help="also write the results as JSON")
+    s.add_argument("--campaign-runs", type=int, metavar="N",
+                   help="runs of the pipeline campaign (default 100000; 0 skips it)")
+    s.add_argument("--chunk-size", type=int, metavar="N",
+                   help="cases per chunk of the campaign (default: about 100 chunks)")
+    s.add_argument("--profile", metavar="FILE",
+                   help="profile the campaign with cProfile and write the statistics to FILE")
     s.set_defaults(func=cmd_bench)
     return p
 

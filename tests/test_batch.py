@@ -291,3 +291,35 @@ def test_error_record_kept_with_nan_results(tmp_path):
     assert ds["peak_ship_slip"].sel(record="s0").notnull().all()
     assert ds["failure"].sel(record="s1").notnull().all()
     assert math.isnan(float(ds["scale_factor"].sel(record="bad", im_level=0.3 * G)))
+
+
+def test_run_chunk_converts_only_the_systems_its_cases_use(monkeypatch):
+    intens = IntensityDesign("ida", levels=(0.3 * G, 0.6 * G))
+    recs = [prepare_record(f"s{i}", _loader(i), [], intens) for i in range(2)]
+    systems = [SYSTEM.replace(mu_s_ship=0.3 + 0.01 * k, mu_k_ship=0.3) for k in range(40)]
+    cases = np.array([[0, 1, 7], [1, 0, 31], [0, 1, 31]])
+    seen = []
+    real = batch_mod.simulate_batch
+
+    def spy(systems_, *args, **kwargs):
+        seen.append(list(systems_))
+        return real(systems_, *args, **kwargs)
+
+    monkeypatch.setattr(batch_mod, "simulate_batch", spy)
+    out = run_chunk([r.payload() for r in recs], systems, cases)
+    assert seen == [[systems[7], systems[31]]]
+    ref = run_chunk([r.payload() for r in recs], [systems[7], systems[31]],
+                    np.array([[0, 1, 0], [1, 0, 1], [0, 1, 1]]))
+    for name in out:
+        np.testing.assert_array_equal(out[name], ref[name])
+
+
+def test_run_batch_results_do_not_depend_on_the_chunk_size(tmp_path):
+    design, recs = _batch_setup(bad=True)
+    results = [run_batch(design, recs, ChunkStore(tmp_path / str(c), "fp").open(),
+                         chunk_size=c, progress=False) for c in (1, 3, 5, 100)]
+    for other in results[1:]:
+        assert set(other) == set(results[0])
+        for name in results[0]:
+            np.testing.assert_array_equal(other[name], results[0][name])
+    assert list(results[0]["run_error"]) == [""] * 12  # the bad record has no run errors

@@ -168,9 +168,12 @@ def test_netcdf_round_trip_units_and_compression(ida_run):
 
 def test_output_override_and_rerun_gives_same_result(ida_run, tmp_path):
     tmp, path, ds = ida_run
-    again = run_pipeline(path, output=tmp_path / "other.nc", progress=False)
+    timings = {}
+    again = run_pipeline(path, output=tmp_path / "other.nc", progress=False, timings=timings)
     assert (tmp_path / "other.nc").is_file()
     assert_same_results(ds, again)
+    assert list(timings) == ["records", "solver", "runs", "fragility", "write"]
+    assert all(t >= 0 for t in timings.values()) and timings["solver"] <= timings["runs"]
 
 
 def test_sweep_msa_and_error_record(tmp_path):

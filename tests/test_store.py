@@ -44,6 +44,29 @@ def test_chunk_store_round_trip_and_fingerprint(tmp_path):
     assert not (tmp_path / "p").exists()
 
 
+def test_chunk_file_layout_and_older_layout_still_read(tmp_path):
+    store = ChunkStore(tmp_path / "p", "abc").open()
+    names = list(RUN_VARIABLES)
+    arrays = {name: np.arange(4.0) + i for i, name in enumerate(names)}
+    arrays["run_error"] = np.full(4, "", dtype="U80")
+    store.write(0, [0, 1, 2, 3], arrays)
+    with np.load(tmp_path / "p" / "chunk-000000.npz") as data:
+        assert sorted(data.files) == ["cases", "names", "v_run_error", "values"]
+        assert data["values"].shape == (len(names), 4)
+        assert data["v_run_error"].dtype == np.dtype("U1")  # empty messages stored narrow
+    cases, back = store.read(0)
+    assert list(back) == [*names, "run_error"]
+    for name in names:
+        np.testing.assert_array_equal(back[name], arrays[name])
+    # one entry per variable, as written by shipblock 0.1.0 before the 2-D layout
+    np.savez(tmp_path / "p" / "chunk-000001.npz", cases=np.arange(4, 6),
+             v_peak_ship_slip=np.array([0.5, np.nan]), v_run_error=np.array(["", "x"]))
+    cases, back = store.read(1)
+    np.testing.assert_array_equal(cases, [4, 5])
+    np.testing.assert_array_equal(back["peak_ship_slip"], [0.5, np.nan])
+    assert list(back["run_error"]) == ["", "x"]
+
+
 def test_unreadable_chunk_raises_store_error(tmp_path):
     store = ChunkStore(tmp_path / "p", "abc").open()
     (tmp_path / "p" / "chunk-000000.npz").write_bytes(b"garbage")

@@ -24,6 +24,7 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
@@ -51,9 +52,11 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-#: Default largest number of cases per chunk [-]: large enough to keep all cores busy in one
-#: :func:`~shipblock.simulate_batch` call, small enough that a killed batch loses little.
-DEFAULT_CHUNK_SIZE = 64
+#: Default largest number of cases per chunk [-]: large enough that the fixed cost of a chunk
+#: (about 1 ms: one :func:`~shipblock.simulate_batch` call, one file written and synced) is
+#: small against its runs even at tens of microseconds per run, small enough that a killed
+#: batch loses little.
+DEFAULT_CHUNK_SIZE = 1024
 
 
 @dataclass
@@ -216,18 +219,23 @@ def run_chunk(records, systems, cases, *, rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL,
         The summary arrays of :func:`~shipblock.simulate_batch`, one value per case.
     """
     cases = np.asarray(cases, dtype=np.int64).reshape(-1, 3)
-    pairs, pair_of_case = np.unique(cases[:, :2], axis=0, return_inverse=True)
+    # each (record, level) pair is scaled once and each system converted once, and only those
+    # the chunk uses: the cost of a chunk does not grow with the size of the whole design
+    n_levels = int(cases[:, 1].max(initial=0)) + 1
+    pairs, pair_of_case = np.unique(cases[:, 0] * n_levels + cases[:, 1], return_inverse=True)
+    used, system_of_case = np.unique(cases[:, 2], return_inverse=True)
     inputs, dts = [], []
-    for r, j in pairs:
+    for pair in pairs.tolist():
+        r, j = divmod(pair, n_levels)
         h, v, dt, fh, fv = records[r]
         f_v = fv[j]
         vertical = None if v is None or not np.isfinite(f_v) or f_v == 0.0 else f_v * v
         inputs.append((fh[j] * h, vertical))
         dts.append(dt)
-    batch = np.column_stack([pair_of_case.ravel(), cases[:, 2], np.ones(len(cases)),
-                             np.ones(len(cases))])
-    return simulate_batch(list(systems), inputs, dts, batch, rtol=rtol, atol=atol,
-                          zeno_omega=zeno_omega)
+    ones = np.ones(len(cases))
+    batch = np.column_stack([pair_of_case.ravel(), system_of_case.ravel(), ones, ones])
+    return simulate_batch([systems[i] for i in used.tolist()], inputs, dts, batch, rtol=rtol,
+                          atol=atol, zeno_omega=zeno_omega)
 
 
 def _mark_solver_errors(out: dict) -> np.ndarray:
@@ -235,6 +243,8 @@ def _mark_solver_errors(out: dict) -> np.ndarray:
     failure = out["failure"]
     messages = np.full(failure.shape, "", dtype="U80")
     bad = failure == int(Failure.SOLVER_ERROR)
+    if not bad.any():
+        return messages
     for i in np.flatnonzero(bad):
         messages[i] = (f"solver error (failure code {int(Failure.SOLVER_ERROR)}) at "
                        f"t = {out['failure_time'][i]:.6g} s")
@@ -247,11 +257,14 @@ def _mark_solver_errors(out: dict) -> np.ndarray:
 # the batch
 # --------------------------------------------------------------------------------------------
 
+_NAMES = tuple(RUN_VARIABLES)
+
 
 class _Task:
     """What one chunk needs: its cases, the runnable ones and their local indices."""
 
     def __init__(self, design: AnalysisDesign, chunk: range, ok_records: np.ndarray):
+        self.chunk = chunk
         self.cases = np.arange(chunk.start, chunk.stop, dtype=np.int64)
         idx = design.case_indices(self.cases)
         self.runnable = ok_records[idx[:, 0]]
@@ -259,19 +272,25 @@ class _Task:
         self.records, local = np.unique(idx[:, 0], return_inverse=True)
         self.local_cases = np.column_stack([local.ravel(), idx[:, 1], idx[:, 2]])
 
-    def assemble(self, out: dict | None) -> dict:
-        """Full-chunk arrays (NaN for cases of failed records) from the solver output."""
+    def assemble(self, out: dict | None) -> tuple[np.ndarray, np.ndarray]:
+        """Full-chunk results (NaN for cases of failed records) from the solver output.
+
+        Returns
+        -------
+        values : numpy.ndarray, shape (len(RUN_VARIABLES), n)
+            One row per run variable, in the order of ``RUN_VARIABLES``.
+        errors : numpy.ndarray of str, shape (n,)
+            ``run_error`` of each case.
+        """
         n = self.cases.size
-        arrays = {name: np.full(n, np.nan) for name in RUN_VARIABLES}
+        values = np.full((len(_NAMES), n), np.nan)
         errors = np.full(n, "", dtype="U80")
         if out is not None:
-            out = {k: np.asarray(v, dtype=float) for k, v in out.items()}
+            out = {name: np.asarray(out[name], dtype=float) for name in _NAMES}
             msg = _mark_solver_errors(out)
-            for name in RUN_VARIABLES:
-                arrays[name][self.runnable] = out[name]
+            values[:, self.runnable] = np.stack([out[name] for name in _NAMES])
             errors[self.runnable] = msg
-        arrays["run_error"] = errors
-        return arrays
+        return values, errors
 
 
 def run_batch(
@@ -283,6 +302,7 @@ def run_batch(
     client=None,
     progress: bool = True,
     solver_options: Mapping | None = None,
+    timings: dict | None = None,
 ) -> dict:
     """Run every case of a design, resuming from the chunks already in ``store``.
 
@@ -302,6 +322,9 @@ def run_batch(
         Show a tqdm progress bar (runs done, rate, time left).
     solver_options : mapping, optional
         ``rtol``, ``atol``, ``zeno_omega`` for :func:`run_chunk`.
+    timings : dict, optional
+        ``timings["solver"]`` is increased by the wall time spent in :func:`run_chunk` [s]
+        (local runs only).
 
     Returns
     -------
@@ -316,13 +339,14 @@ def run_batch(
     systems = design.systems()
     chunks = design.chunks(chunk_size)
     n = design.n_cases
-    results = {name: np.full(n, np.nan) for name in RUN_VARIABLES}
-    results["run_error"] = np.full(n, "", dtype=object)
+    # one row per run variable: filled a chunk at a time, returned as row views
+    table = np.full((len(_NAMES), n), np.nan)
+    run_error = np.full(n, "", dtype=object)
 
-    def fill(chunk: range, arrays: dict):
-        for name, values in arrays.items():
-            if name in results:
-                results[name][chunk.start:chunk.stop] = values
+    def fill(chunk: range, values: np.ndarray, errors: np.ndarray):
+        table[:, chunk.start:chunk.stop] = values
+        bad = np.flatnonzero(errors != "")
+        run_error[chunk.start + bad] = errors[bad]
 
     pending = []
     done_cases = 0
@@ -331,12 +355,14 @@ def run_batch(
         if k in available:
             try:
                 cases, arrays = store.read(k)
-            except StoreError as exc:
-                logger.warning("%s; recomputing it", exc)
+                values = np.stack([np.asarray(arrays[name], dtype=float) for name in _NAMES])
+                errors = np.asarray(arrays["run_error"], dtype=str)
+            except (StoreError, KeyError, ValueError) as exc:
+                logger.warning("chunk %d unusable (%s); recomputing it", k, exc)
                 store.discard(k)
             else:
                 if np.array_equal(cases, np.arange(chunk.start, chunk.stop)):
-                    fill(chunk, arrays)
+                    fill(chunk, values, errors)
                     done_cases += len(chunk)
                     continue
                 store.discard(k)
@@ -351,10 +377,12 @@ def run_batch(
         tasks = {k: _Task(design, chunks[k], ok) for k in pending}
 
         def finish(k: int, out):
-            arrays = tasks[k].assemble(out)
-            store.write(k, tasks[k].cases, arrays)
-            fill(chunks[k], arrays)
-            bar.update(len(chunks[k]))
+            task = tasks.pop(k)
+            values, errors = task.assemble(out)
+            store.write(k, task.cases, {**dict(zip(_NAMES, values, strict=True)),
+                                        "run_error": errors})
+            fill(task.chunk, values, errors)
+            bar.update(len(task.chunk))
 
         runnable = [k for k in pending if tasks[k].local_cases.size]
         for k in pending:
@@ -364,11 +392,17 @@ def run_batch(
             for k in runnable:
                 t = tasks[k]
                 payload = [records[r].payload() for r in t.records]
-                finish(k, run_chunk(payload, systems, t.local_cases, **opts))
+                t0 = time.perf_counter()
+                out = run_chunk(payload, systems, t.local_cases, **opts)
+                if timings is not None:
+                    timings["solver"] = timings.get("solver", 0.0) + time.perf_counter() - t0
+                finish(k, out)
         else:
             _run_dask(client, records, systems, tasks, runnable, opts, finish)
     finally:
         bar.close()
+    results = dict(zip(_NAMES, table, strict=True))
+    results["run_error"] = run_error
     return results
 
 

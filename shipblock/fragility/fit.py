@@ -69,6 +69,18 @@ __all__ = [
 #: Gradient tolerance per observation of the censored IDA likelihood maximisation [-].
 _GTOL_PER_OBS = 1e-9
 
+_LOG_SQRT_2PI = np.log(np.sqrt(2 * np.pi))
+
+
+def _norm_logpdf(x):
+    """Standard normal log density.
+
+    The expression of ``scipy.stats.norm.logpdf(x)`` (the same result bit for bit) without its
+    per-call overhead, which dominated the time of the censored IDA fits.
+    """
+    return -(x**2) / 2.0 - _LOG_SQRT_2PI
+
+
 #: Smallest dispersion accepted as a finite-beta fit [-]. Below it the data are (numerically)
 #: separated and the lognormal curve degenerates to a step.
 _MIN_BETA = 1e-6
@@ -655,7 +667,7 @@ def fit_ida(capacities, censored_at=None, *, method="mle") -> FragilityFit:
     mu0, sigma0 = float(np.mean(y)), float(np.std(y))
     if n_censored == 0:
         mu, sigma = mu0, sigma0
-        nll = -np.sum(stats.norm.logpdf(y, mu, sigma))
+        nll = -np.sum(_norm_logpdf((y - mu) / sigma) - np.log(sigma))
         n_iter = 0
     else:
 
@@ -665,8 +677,8 @@ def fit_ida(capacities, censored_at=None, *, method="mle") -> FragilityFit:
             r = (y - mu) / s
             rc = (y_cens - mu) / s
             log_sf = special.log_ndtr(-rc)
-            mills = np.exp(stats.norm.logpdf(rc) - log_sf)  # hazard of the censored terms
-            nll = -np.sum(stats.norm.logpdf(r) - log_s) - np.sum(log_sf)
+            mills = np.exp(_norm_logpdf(rc) - log_sf)  # hazard of the censored terms
+            nll = -np.sum(_norm_logpdf(r) - log_s) - np.sum(log_sf)
             g_mu = -np.sum(r) / s - np.sum(mills) / s
             g_ls = -np.sum(r**2 - 1.0) - np.sum(mills * rc)
             return nll, np.array([g_mu, g_ls])

@@ -57,7 +57,7 @@ Schema (``schema_version = 1``; units in brackets, paths relative to the pipelin
     zeno_omega = 1e-7                   # [rad/s]
 
     [execution]
-    chunk_size = 64                     # cases per chunk (part of the run's identity)
+    chunk_size = 1024                   # cases per chunk (part of the run's identity)
     scheduler = "tcp://host:8786"       # optional Dask scheduler
 
 IM levels are converted to SI once, here: ``levels_g`` multiplies by
@@ -73,6 +73,7 @@ import itertools
 import json
 import logging
 import math
+import time
 import tomllib
 import warnings
 from collections.abc import Mapping
@@ -781,6 +782,20 @@ def _limit_state_coords(limit_states) -> dict:
 # --------------------------------------------------------------------------------------------
 
 
+class _StageClock:
+    """Adds the wall time since the previous lap to ``timings[stage]`` (no-op without a dict)."""
+
+    def __init__(self, timings: dict | None):
+        self.timings = timings
+        self.t = time.perf_counter()
+
+    def lap(self, stage: str) -> None:
+        now = time.perf_counter()
+        if self.timings is not None:
+            self.timings[stage] = self.timings.get(stage, 0.0) + now - self.t
+        self.t = now
+
+
 def _fingerprint(pipe: Pipeline, records) -> str:
     from shipblock import __version__
 
@@ -801,8 +816,8 @@ def _loader(entry, pipe: Pipeline):
     return load
 
 
-def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool = True
-                 ) -> xr.Dataset:
+def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool = True,
+                 timings: dict | None = None) -> xr.Dataset:
     """Run a pipeline file end to end and return the dataset it wrote.
 
     Parameters
@@ -819,6 +834,12 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         ``execution.scheduler``); ignored when ``client`` is given.
     progress : bool
         Show a progress bar (runs done, rate, time left).
+    timings : dict, optional
+        Filled with the wall time of each stage [s]: ``records`` (pipeline parsed, records
+        read, processed and scaled, partial-results directory opened),
+        ``runs`` (all chunks, with ``solver`` the part spent in
+        :func:`~shipblock.fragility.batch.run_chunk` when run locally), ``fragility``
+        (dataset, limit states, fits), ``write`` (NetCDF written and read back).
 
     Returns
     -------
@@ -834,6 +855,7 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     from shipblock.catalogue import load_catalogue
     from shipblock.processing import DEFAULT_CHAIN
 
+    clock = _StageClock(timings)
     pipe = load_pipeline(path)
     out_path = Path(output).resolve() if output is not None else pipe.output
     design = pipe.design
@@ -849,6 +871,7 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
                     "pipeline": pipe.source})
     except StoreError as exc:
         raise PipelineError("output", str(exc), pipe.source) from None
+    clock.lap("records")
     own_client = None
     scheduler = scheduler or pipe.scheduler
     if client is None and scheduler:
@@ -857,10 +880,11 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         client = own_client = Client(scheduler)
     try:
         results = run_batch(design, records, store, chunk_size=pipe.chunk_size, client=client,
-                            progress=progress, solver_options=pipe.solver)
+                            progress=progress, solver_options=pipe.solver, timings=timings)
     finally:
         if own_client is not None:
             own_client.close()
+    clock.lap("runs")
     ds = summary_dataset(design, records, results)
     ds = ds.assign_coords({k: xr.Variable(*v) for k, v in _limit_state_coords(
         pipe.limit_states).items()})
@@ -893,7 +917,10 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     }
     if intensity.period is not None:
         ds.attrs["im_period"] = intensity.period
+    clock.lap("fragility")
     write_dataset(ds, out_path)
     store.remove()
     logger.info("wrote %s", out_path)
-    return open_results(out_path)
+    ds = open_results(out_path)
+    clock.lap("write")
+    return ds

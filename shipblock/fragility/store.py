@@ -23,6 +23,7 @@ import json
 import os
 import shutil
 import tempfile
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -183,6 +184,9 @@ class ChunkStore:
     def write(self, chunk_id: int, cases, arrays: dict) -> None:
         """Write one finished chunk atomically.
 
+        The float arrays are stored as the rows of one 2-D array (a few large entries in the
+        ``.npz`` file rather than one per variable), string arrays at their narrowest width.
+
         Parameters
         ----------
         chunk_id : int
@@ -193,9 +197,23 @@ class ChunkStore:
             Per-case results (float arrays of the length of ``cases``) and optional string
             arrays (``run_error``).
         """
-        payload = {"cases": np.asarray(cases, dtype=np.int64)}
+        cases = np.asarray(cases, dtype=np.int64)
+        payload = {"cases": cases}
+        names = []
+        rows = []
         for name, value in arrays.items():
-            payload[f"v_{name}"] = np.asarray(value)
+            value = np.asarray(value)
+            if value.dtype == np.float64 and value.shape == cases.shape:
+                names.append(name)
+                rows.append(value)
+            elif value.dtype.kind == "U" and value.size:
+                width = max(1, int(np.char.str_len(value).max()))
+                payload[f"v_{name}"] = value.astype(f"U{width}")
+            else:
+                payload[f"v_{name}"] = value
+        if rows:
+            payload["names"] = np.array(names)
+            payload["values"] = np.stack(rows)
         _atomic_write(self._path(chunk_id), lambda fh: np.savez(fh, **payload))
 
     def read(self, chunk_id: int) -> tuple[np.ndarray, dict]:
@@ -220,8 +238,11 @@ class ChunkStore:
         try:
             with np.load(path, allow_pickle=False) as data:
                 cases = data["cases"]
-                arrays = {k[2:]: data[k] for k in data.files if k.startswith("v_")}
-        except (OSError, ValueError, KeyError) as exc:
+                arrays = {}
+                if "values" in data.files:
+                    arrays.update(zip(data["names"].tolist(), data["values"], strict=True))
+                arrays.update({k[2:]: data[k] for k in data.files if k.startswith("v_")})
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
             raise StoreError(f"{path}: unreadable chunk file ({exc})") from exc
         return cases, arrays
 

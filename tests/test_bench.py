@@ -1,0 +1,124 @@
+"""Tests of the benchmark machinery (what is measured and how), never of the speed itself.
+
+The campaign is run end to end on two short synthetic records (see
+``test_batch.make_catalogue``), in its own subprocess as ``shipblock bench`` runs it.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import sys
+
+import numpy as np
+import pytest
+
+from shipblock import bench
+from shipblock.cli import main
+from shipblock.fragility.pipeline import load_pipeline
+
+from .test_batch import make_catalogue
+
+
+@pytest.mark.parametrize("n_runs", [1, 6, 50, 324, 1000, 3000, 100_000])
+def test_campaign_grid_is_the_smallest_near_square_grid(n_runs):
+    n_levels, n_mu, n_sl = bench.campaign_grid(n_runs, n_records=6)
+    total = 6 * n_levels * n_mu * n_sl
+    assert total >= n_runs
+    assert total <= 1.01 * n_runs or total - n_runs < 6 * n_levels * n_mu
+    assert n_mu <= n_sl <= max(2 * n_mu, n_mu + 1)
+    assert 1 <= n_levels <= 12
+    assert bench.campaign_grid(3000) == (10, 5, 10)  # exactly 3000 runs
+    assert 6 * math.prod(bench.campaign_grid(100_000)) < 100_200
+
+
+def test_campaign_pipeline_is_valid_and_has_the_runs(tmp_path):
+    path, info = bench.write_campaign_pipeline(tmp_path, 1000, chunk_size=128)
+    pipe = load_pipeline(path)
+    assert pipe.design.n_cases == info["runs"] >= 1000
+    assert len(pipe.design.records) == info["records"] == 6  # the shipped catalogue
+    assert pipe.design.shape == (6, info["levels"], info["n_mu"], info["n_slenderness"])
+    assert pipe.chunk_size == 128
+    assert pipe.fit["bootstrap"] == 0
+    _, info = bench.write_campaign_pipeline(tmp_path / "b", 100_000)
+    assert info["chunk_size"] == -(-info["runs"] // 100)  # about 100 chunks
+
+
+def test_kernel_time_is_found_in_a_profile():
+    import cProfile
+    import pstats
+
+    from shipblock import simulate_batch
+
+    system = bench.sliding_system()
+    acc = np.sin(np.arange(4000) * 0.02)
+    cases = np.array([[0, 0, 1.0, 1.0]] * 4)
+    simulate_batch(system, [(acc, None)], [0.005], cases[:1])
+    prof = cProfile.Profile()
+    prof.runcall(simulate_batch, system, [(acc, None)], [0.005], cases)
+    stats = pstats.Stats(prof)
+    kernel = bench._kernel_seconds(stats)
+    assert 0 < kernel <= stats.total_tt
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc/self/status is Linux")
+def test_memory_is_read_from_proc():
+    rss, peak = bench._memory()
+    assert 1e6 < rss <= peak
+    block = np.ones(50_000_000 // 8)  # touch 50 MB
+    assert bench._memory()[1] >= peak + 40e6
+    del block
+
+
+def test_campaign_runs_the_pipeline_in_a_subprocess(tmp_path):
+    catalogue = make_catalogue(tmp_path / "records", n_records=2)
+    res = bench.campaign(40, directory=tmp_path / "work", catalogue=catalogue,
+                         profile=tmp_path / "campaign.prof")
+    assert res["runs"] == 2 * res["levels"] * res["n_mu"] * res["n_slenderness"] >= 40
+    assert res["failed_runs"] == 0
+    assert set(res["stages"]) == {"records", "runs", "solver", "fragility", "write"}
+    assert res["stages"]["solver"] <= res["stages"]["runs"] <= res["seconds"]
+    assert res["runs_per_s"] == pytest.approx(res["runs"] / res["seconds"])
+    assert (tmp_path / "work" / "campaign.nc").stat().st_size == res["netcdf_bytes"] > 0
+    assert (tmp_path / "campaign.prof").is_file()
+    prof = res["profile"]
+    assert 0 < prof["kernel"] <= prof["stages"]["batch"] < prof["total"]
+    assert set(prof["stages"]) == {"batch", "records", "fits", "netcdf_write", "netcdf_read"}
+    assert all(t > 0 for t in prof["stages"].values())
+    if sys.platform.startswith("linux"):
+        mem = res["memory"]
+        assert 0 < mem["imports"] <= mem["warmup"] and mem["before"] <= mem["peak"]
+        assert mem["increase"] == mem["peak"] - mem["before"]
+
+
+def test_campaign_report_states_targets_only_for_a_full_campaign():
+    c = {"runs": 324, "records": 6, "levels": 9, "n_mu": 2, "n_slenderness": 3,
+         "chunk_size": 64, "seconds": 2.0, "runs_per_s": 162.0, "us_per_run": 6173.0,
+         "failed_runs": 0, "stages": {"records": 0.3, "runs": 1.5, "solver": 1.4,
+                                      "fragility": 0.1, "write": 0.1},
+         "memory": {"imports": 250e6, "warmup": 350e6, "before": 350e6, "peak": 380e6,
+                    "increase": 30e6, "peak_reset": True}}
+    out = io.StringIO()
+    bench._write_campaign(out, c)
+    text = out.getvalue()
+    assert "applies to 100000 runs" in text and "NOT met" not in text
+    assert "the campaign added 30 MB" in text
+    out = io.StringIO()
+    profile = {"total": 210.0, "kernel": 190.0,
+               "stages": {"batch": 195.0, "records": 1.0, "fits": 3.0, "netcdf_write": 0.5,
+                          "netcdf_read": 0.2}}
+    bench._write_campaign(out, {**c, "runs": 100_122, "seconds": 200.0, "profile": profile})
+    text = out.getvalue()
+    assert "(target 120 s: NOT met)" in text and "(target 200 MB: met)" in text
+    assert "90.5 % of the profiled time in compiled kernels" in text
+    assert "batch loop 5 s, records 1 s, fits 3 s, NetCDF 0.7 s" in text
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["bench", "--campaign-runs", "-1"], "--campaign-runs must be >= 0"),
+    (["bench", "--chunk-size", "0"], "--chunk-size must be >= 1"),
+])
+def test_bench_arguments_are_checked(argv, needle, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert needle in err and err.count("\n") == 1
