@@ -928,19 +928,13 @@ def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params
     ``offsets[r]:offsets[r+1]``. Only summaries are produced.
     """
     n_cases = case_record.shape[0]
+    empty_hist = np.zeros((0, N_HIST))
+    empty_modes = np.zeros(0, dtype=np.int64)
+    at_rest = np.zeros(N_DYN)
     for c in prange(n_cases):
         r = case_record[c]
         a0 = offsets[r]
         a1 = offsets[r + 1]
-        # Private copies of everything the run touches: arrays shared between threads would
-        # have their reference counts updated atomically by every thread on every call down
-        # the kernel's call tree, and that contended cache line costs more than the copies.
-        p_c = params[case_params[c]].copy()
-        h_c = acc_h[a0:a1].copy()
-        v_c = acc_v[a0:a1].copy() if has_v[r] else h_c  # not read without a vertical record
-        summary_c = np.empty(N_SUMMARY)
-        run(p_c, h_c, v_c, has_v[r], case_sh[c], case_sv[c], dts[r], rtol, atol, zeno_omega,
-            False, np.zeros((0, N_HIST)), np.zeros(0, dtype=np.int64), summary_c,
-            np.zeros(N_DYN))
-        for i in range(N_SUMMARY):
-            summaries[c, i] = summary_c[i]
+        run(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
+            case_sv[c], dts[r], rtol, atol, zeno_omega, False, empty_hist, empty_modes,
+            summaries[c], at_rest)
