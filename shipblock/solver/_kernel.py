@@ -412,7 +412,21 @@ def interface_option(v, i):
 
 
 @njit(cache=True)
-def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
+def candidate_options(idx, vb, rot, vs):
+    """Interface options of candidate ``idx`` (0..26): three (flag, sign, new) triples.
+
+    ``idx = 9 i_ground + 3 i_rocking + i_ship`` enumerates the options of
+    :func:`interface_option`; ``rot`` is theta, or theta_dot at theta = 0 (just after an
+    impact), whose sign gives the pivot.
+    """
+    slip1, sig1, new1 = interface_option(vb, idx // 9)
+    rock, s, newr = interface_option(rot, (idx // 3) % 3)
+    slip2, sig2, new2 = interface_option(vs, idx % 3)
+    return slip1, sig1, new1, rock, s, newr, slip2, sig2, new2
+
+
+@njit(cache=True)
+def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7, order):
     """Choose the next mode among the candidates consistent with the velocities.
 
     Candidates: an interface with a nonzero slip velocity keeps slipping that way; one at zero
@@ -423,6 +437,12 @@ def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
     holds, new motions accelerate in their assumed direction and both normal forces are positive.
     Among consistent candidates the one with the fewest new motions wins; ties go to the one
     releasing ``trigger`` (0 ground, 1 rocking, 2 ship), then to the lower paper mode number.
+    If none is consistent, the one with the least total violation is taken.
+
+    The candidates are visited in that order of preference (by number of new motions, then
+    trigger, then mode number; ``order`` is a work array of 27 integers), so the first
+    consistent one is the choice and the search stops there: after most events one or two
+    candidates are solved instead of up to 27.
 
     Returns
     -------
@@ -437,101 +457,89 @@ def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
     weight = (p[P_NM] + p[P_M]) * p[P_G]
     ship_weight = p[P_M] * p[P_G]
     vb, th, om, vs = y[Y_VB], y[Y_TH], y[Y_OM], y[Y_VS]
-    best_key0 = 3
-    best_key1 = 1e300
+    rot = th if th != 0.0 else om
+    best_viol = 1e300
     best_key2 = 2
     best_mode = 99
     best0 = best1 = best2 = best3 = best4 = best5 = 0
     all_separate = True
-    # Candidates are visited by the number of new motions they start: a consistent candidate
-    # with fewer new motions beats every one with more, so the search ends at the first level
-    # holding a consistent candidate (usually the first: nothing new starts). The fallback
-    # (no consistent candidate) has then compared the violations of all of them.
     for level in range(4):
-        for i1 in range(3):
-            slip1, sig1, new1 = interface_option(vb, i1)
-            if slip1 < 0:
+        # this level's candidates, sorted by (releases the trigger, mode number, enumeration)
+        n_c = 0
+        # level 0 is candidate 0 alone (every interface goes on as it is)
+        for idx in range(1 if level == 0 else 27):
+            slip1, sig1, new1, rock, s, newr, slip2, sig2, new2 = candidate_options(idx, vb, rot, vs)
+            if slip1 < 0 or rock < 0 or slip2 < 0 or new1 + newr + new2 != level:
                 continue
-            for ir in range(3):
-                # the pivot follows theta, or theta_dot at theta = 0 (just after an impact)
-                rock, s, newr = interface_option(th if th != 0.0 else om, ir)
-                if rock < 0:
-                    continue
-                for i2 in range(3):
-                    slip2, sig2, new2 = interface_option(vs, i2)
-                    if slip2 < 0:
-                        continue
-                    if new1 + newr + new2 != level:
-                        continue
-                    ok = solve_mode(p, slip1, rock, slip2, float(s), float(sig1), float(sig2),
-                                    th, om, a, G, w7)
-                    if not ok:
-                        continue
-                    fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
-                    viol = 0.0
-                    separate = fy <= 0.0 or Fy <= 0.0
-                    if not separate:
-                        all_separate = False
-                    else:
-                        viol += max(0.0, -fy / weight) + max(0.0, -Fy / ship_weight) + 1.0
-                    if slip1 == 0:
-                        v = (abs(fx) - p[P_MUS1] * fy) / weight
-                        if v > FORCE_TOL:
-                            viol += v
-                    elif new1:
-                        v = sig1 * w7[0] / p[P_G]
-                        if v <= ACC_TOL:
-                            viol += ACC_TOL - v
-                    if rock == 0:
-                        v = (p[P_H] * abs(fx + Fx) - p[P_B] * (fy + Fy)) / (weight * p[P_R])
-                        if v > FORCE_TOL:
-                            viol += v
-                    elif newr:
-                        v = s * w7[1] * p[P_R] / p[P_G]
-                        if v <= ACC_TOL:
-                            viol += ACC_TOL - v
-                    if slip2 == 0:
-                        v = (abs(Fx) - p[P_MUS2] * Fy) / ship_weight
-                        if v > FORCE_TOL:
-                            viol += v
-                    elif new2:
-                        v = sig2 * w7[2] / p[P_G]
-                        if v <= ACC_TOL:
-                            viol += ACC_TOL - v
-                    n_new = new1 + newr + new2
-                    if trigger == 0:
-                        releases = new1
-                    elif trigger == 1:
-                        releases = newr
-                    elif trigger == 2:
-                        releases = new2
-                    else:
-                        releases = 0
-                    mode = mode_number_of(slip1, rock, slip2)
-                    if viol == 0.0:
-                        key0, key1 = 0, float(n_new)
-                    else:
-                        key0, key1 = 1, viol
-                    key2 = 0 if releases else 1
-                    better = False
-                    if key0 < best_key0:
-                        better = True
-                    elif key0 == best_key0:
-                        if key1 < best_key1:
-                            better = True
-                        elif key1 == best_key1:
-                            if key2 < best_key2 or key2 == best_key2 and mode < best_mode:
-                                better = True
-                    if better:
-                        best_key0, best_key1, best_key2, best_mode = key0, key1, key2, mode
-                        best0, best1, best2 = slip1, rock, slip2
-                        best3, best4, best5 = s, sig1, sig2
-        if best_key0 == 0:
-            break
+            if trigger == 0:
+                releases = new1
+            elif trigger == 1:
+                releases = newr
+            elif trigger == 2:
+                releases = new2
+            else:
+                releases = 0
+            key = ((0 if releases else 1) * 16 + mode_number_of(slip1, rock, slip2)) * 32 + idx
+            j = n_c
+            while j > 0 and order[j - 1] > key:
+                order[j] = order[j - 1]
+                j -= 1
+            order[j] = key
+            n_c += 1
+        for jc in range(n_c):
+            idx = order[jc] % 32
+            key2 = order[jc] // 512
+            mode = (order[jc] // 32) % 16
+            slip1, sig1, new1, rock, s, newr, slip2, sig2, new2 = candidate_options(idx, vb, rot, vs)
+            ok = solve_mode(p, slip1, rock, slip2, float(s), float(sig1), float(sig2),
+                            th, om, a, G, w7)
+            if not ok:
+                continue
+            fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
+            viol = 0.0
+            separate = fy <= 0.0 or Fy <= 0.0
+            if not separate:
+                all_separate = False
+            else:
+                viol += max(0.0, -fy / weight) + max(0.0, -Fy / ship_weight) + 1.0
+            if slip1 == 0:
+                v = (abs(fx) - p[P_MUS1] * fy) / weight
+                if v > FORCE_TOL:
+                    viol += v
+            elif new1:
+                v = sig1 * w7[0] / p[P_G]
+                if v <= ACC_TOL:
+                    viol += ACC_TOL - v
+            if rock == 0:
+                v = (p[P_H] * abs(fx + Fx) - p[P_B] * (fy + Fy)) / (weight * p[P_R])
+                if v > FORCE_TOL:
+                    viol += v
+            elif newr:
+                v = s * w7[1] * p[P_R] / p[P_G]
+                if v <= ACC_TOL:
+                    viol += ACC_TOL - v
+            if slip2 == 0:
+                v = (abs(Fx) - p[P_MUS2] * Fy) / ship_weight
+                if v > FORCE_TOL:
+                    viol += v
+            elif new2:
+                v = sig2 * w7[2] / p[P_G]
+                if v <= ACC_TOL:
+                    viol += ACC_TOL - v
+            if viol == 0.0:
+                # the most preferred consistent candidate: the choice
+                ms[0], ms[1], ms[2], ms[3], ms[4], ms[5] = slip1, rock, slip2, s, sig1, sig2
+                return 0
+            if viol < best_viol or (viol == best_viol and (
+                    key2 < best_key2 or key2 == best_key2 and mode < best_mode)):
+                best_viol, best_key2, best_mode = viol, key2, mode
+                best0, best1, best2 = slip1, rock, slip2
+                best3, best4, best5 = s, sig1, sig2
     if all_separate:
         return 2
     ms[0], ms[1], ms[2], ms[3], ms[4], ms[5] = best0, best1, best2, best3, best4, best5
-    return 0 if best_key0 == 0 else 1
+    return 1
+
 
 
 @njit(cache=True)
@@ -599,6 +607,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     f_end = np.zeros(N_STATE)
     fsal = False  # stages[0] holds f(y) in the current mode
     resp = np.zeros((2, N_SOLVE_OUT))
+    order = np.zeros(27, dtype=np.int64)
     peaks = np.zeros(2)
     g1 = np.zeros(N_EVENTS)
     gw = np.zeros(N_EVENTS)
@@ -626,7 +635,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
         y[i] = y_init[i]
     k = 0
     tau = 0.0
-    status = select_mode(p, y, ms, 0, 0.0, dt, ax, ay, has_ay, sh, sv, -1, w7)
+    status = select_mode(p, y, ms, 0, 0.0, dt, ax, ay, has_ay, sh, sv, -1, w7, order)
     if status == 2:
         failure = Failure.SEPARATION
         failure_time = 0.0
@@ -828,7 +837,8 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
                 kind = EventKind.SEPARATION
             if failure == 0:
                 old0, old1, old2, old3, old4, old5 = ms[0], ms[1], ms[2], ms[3], ms[4], ms[5]
-                status = select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7)
+                status = select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7,
+                                     order)
                 if status == 2:
                     failure = Failure.SEPARATION
                     kind = EventKind.SEPARATION

@@ -1,0 +1,93 @@
+"""Mode selection after an event: the ordered, early-stopping search in the kernel picks the
+same mode as comparing every candidate by the rule of docs/theory/transitions."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from shipblock import ShipBlockSystem
+from shipblock.equations import mode_response
+from shipblock.modes import MODE_NUMBER
+from shipblock.solver import _kernel as K
+from shipblock.solver._layout import ACC_TOL, FORCE_TOL, parameter_tuple
+
+
+def reference_choice(system, y, a, ay, trigger):
+    """Every candidate solved and ranked: consistent first, fewest new motions, releases the
+    trigger, lower mode number, enumeration order; else least violation. Returns the mode
+    state (slip1, rock, slip2, s, sig1, sig2) and whether it was consistent."""
+    g = system.g
+    weight = (system.total_block_mass + system.ship_mass) * g
+    ship_weight = system.ship_mass * g
+    vb, th, om, vs = y[3], y[1], y[4], y[5]
+    rot = th if th != 0 else om
+
+    def options(v):
+        return [(1, 1 if v > 0 else -1, 0)] if v != 0 else [(0, 1, 0), (1, 1, 1), (1, -1, 1)]
+
+    ranked = []
+    for n_enum, ((f1, s1, n1), (fr, sr, nr), (f2, s2, n2)) in enumerate(
+            itertools.product(options(vb), options(rot), options(vs))):
+        mode = int(MODE_NUMBER[f1, fr, f2])
+        try:
+            acc, (fx, fy, Fx, Fy) = mode_response(system, mode, th, om, a, ay, s=sr,
+                                                  sigma_ground=s1, sigma_ship=s2)
+        except ValueError:
+            continue
+        viol = 0.0
+        if fy <= 0 or Fy <= 0:
+            viol += max(0, -fy / weight) + max(0, -Fy / ship_weight) + 1
+        checks = [
+            (f1 == 0, (abs(fx) - system.mu_s_ground * fy) / weight, n1, s1 * acc[0] / g),
+            (fr == 0, (system.half_height * abs(fx + Fx) - system.half_width * (fy + Fy))
+             / (weight * system.half_diagonal), nr, sr * acc[1] * system.half_diagonal / g),
+            (f2 == 0, (abs(Fx) - system.mu_s_ship * Fy) / ship_weight, n2, s2 * acc[2] / g),
+        ]
+        for at_rest, excess, new, push in checks:
+            if at_rest and excess > FORCE_TOL:
+                viol += excess
+            elif not at_rest and new and push <= ACC_TOL:
+                viol += ACC_TOL - push
+        releases = [n1, nr, n2][trigger] if trigger >= 0 else 0
+        consistent = viol == 0
+        key = (0, n1 + nr + n2) if consistent else (1, viol)
+        ranked.append((key, 0 if releases else 1, mode, n_enum, (f1, fr, f2, sr, s1, s2)))
+    best = min(ranked)
+    return best[4], best[0][0] == 0
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_kernel_choice_equals_exhaustive_ranking(seed):
+    rng = np.random.default_rng(seed)
+    system = ShipBlockSystem(ship_mass=4e5, block_mass=1500.0, n_blocks=20, half_width=0.3,
+                             half_height=0.8, mu_s_ground=0.35, mu_k_ground=0.3,
+                             mu_s_ship=0.3, mu_k_ship=0.25)
+    p = parameter_tuple(system.to_parameter_vector())
+    w7 = np.zeros(7)
+    order = np.zeros(27, dtype=np.int64)
+    ms = np.zeros(6, dtype=np.int64)
+    n_checked = 0
+    for _ in range(150):
+        y = np.zeros(9)
+        # each interface at rest or moving either way; theta zero (rest or impact) or not
+        y[3] = rng.choice([0.0, 0.2, -0.2])
+        y[5] = rng.choice([0.0, 0.1, -0.1])
+        if rng.random() < 0.4:
+            y[1] = rng.choice([0.05, -0.05])
+            y[4] = rng.normal() * 0.3
+        elif rng.random() < 0.3:
+            y[4] = rng.choice([0.4, -0.4])  # just after an impact
+        a, ay = rng.normal() * 4.0, rng.normal() * 2.0
+        trigger = int(rng.integers(-1, 3))
+        # the kernel evaluates ONE_SIDED_DT after t; a constant record makes that moot
+        ax_rec, ay_rec = np.full(4, a), np.full(4, ay)
+        status = K.select_mode(p, y, ms, 0, 0.0, 0.01, ax_rec, ay_rec, True, 1.0, 1.0, trigger,
+                               w7, order)
+        want, consistent = reference_choice(system, y, a, ay, trigger)
+        if status == 2:
+            continue
+        assert status == (0 if consistent else 1)
+        assert tuple(int(v) for v in ms) == want
+        n_checked += 1
+    assert n_checked > 100
