@@ -204,6 +204,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
     if has_ay:
         b0 = sv * ay[k]
         b0 = b0 + (sv * ay[k + 1] - b0) * f
+    time_in_mode = 0.0  # accumulated here, added to the summary when the span ends
     while k < n - 1:
         h = dt - tau
         a1 = sh * ax[k + 1]
@@ -278,6 +279,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
                     best_h = r
                     best_e = e
             if best_e >= 0:
+                summary[mode_slot] += time_in_mode
                 return k, tau, best_e, best_h
         # no event: advance exactly to the next sample
         if slip1 or slip2 or vb0 != 0.0 or vs0 != 0.0:
@@ -299,17 +301,17 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
             y[Y_VS] = vs1
             y[Y_WIN] += h * (r0 + 4.0 * rm + r1) / 6.0
             y[Y_DIS] += h * (d0 + 4.0 * dm + d1) / 6.0
-        summary[mode_slot] += h
+            axb = abs(y[Y_XB])
+            if axb > peaks[0]:
+                peaks[0] = axb
+            axs = abs(y[Y_XS])
+            if axs > peaks[1]:
+                peaks[1] = axs
+        time_in_mode += h
         k += 1
         tau = 0.0
         a0 = a1
         b0 = b1
-        axb = abs(y[Y_XB])
-        if axb > peaks[0]:
-            peaks[0] = axb
-        axs = abs(y[Y_XS])
-        if axs > peaks[1]:
-            peaks[1] = axs
         if not all_armed:
             event_functions(p, ms, y, fx1, fy1, Fx1, Fy1, g)
             all_armed = True
@@ -321,6 +323,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
                         all_armed = False
         if store:
             _store(p, y, hist, modes, k, MODE_NUMBER[slip1, 0, slip2])
+    summary[mode_slot] += time_in_mode
     return k, tau, -1, 0.0
 
 
