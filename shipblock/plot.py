@@ -94,8 +94,11 @@ class _DatasetResponse:
         self.system = _System()
 
 
-def active_window(time, acc, events=(), margin=2.0):
-    """Time window holding 1-99 % of the Arias intensity and all events, plus a margin [s]."""
+def active_window(time, acc, events=(), margin=2.0, end=None):
+    """Time window holding 1-99 % of the Arias intensity and all events, plus a margin [s].
+
+    ``end`` (e.g. the failure time) cuts the window there: nothing is computed after it.
+    """
     energy = np.cumsum(np.asarray(acc, float) ** 2)
     if energy[-1] <= 0:
         return time[0], time[-1]
@@ -105,6 +108,8 @@ def active_window(time, acc, events=(), margin=2.0):
     ev = [e.time for e in events if e.kind != "start"]
     if ev:
         t0, t1 = min(t0, min(ev)), max(t1, max(ev))
+    if end is not None and np.isfinite(end):
+        t1 = min(t1, end)
     return max(time[0], t0 - margin), min(time[-1], t1 + 1.5 * margin)
 
 
@@ -152,8 +157,9 @@ def plot_response(result, axes=None, max_event_lines=400, window="auto"):
     if peak > 0.3 * theta_c:
         for sgn in (1, -1):
             ax_t.axhline(sgn * 1000 * theta_c, color="red", lw=0.8, ls="--")
-        ax_t.text(t[0], 1000 * theta_c, r" $\theta_c$ (overturning)", color="red",
-                  va="bottom", fontsize=8)
+        # x in axes fraction: the label stays inside whatever time window is shown
+        ax_t.text(0.005, 1000 * theta_c, r"$\theta_c$ (overturning)", color="red",
+                  va="bottom", fontsize=8, transform=ax_t.get_yaxis_transform())
     ax_s.plot(t, 100 * result.x_s, color="tab:green", lw=1.0)
     ax_s.set_ylabel("ship slip $x_s$ [cm]")
     ax_s.set_xlabel("time [s]")
@@ -194,7 +200,7 @@ def plot_response(result, axes=None, max_event_lines=400, window="auto"):
         axes[3].legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.35),
                        ncol=3, fontsize=7, frameon=False)
     if window == "auto":
-        window = active_window(t, a_h, result.events)
+        window = active_window(t, a_h, result.events, end=result.failure_time)
     if window is not None:
         axes[0].set_xlim(*window)
     title = "ship-block response"

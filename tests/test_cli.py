@@ -96,3 +96,35 @@ def test_run_invalid_pipeline_names_the_key(tmp_path, capsys):
                        __import__("pathlib").Path("records/catalogue.toml").resolve()) + '"'))
     code, _, err = run(capsys, "run", str(bad), "--output", str(tmp_path / "x.nc"))
     assert code == 2 and "design" in err and "type" in err
+
+
+def test_response_figure_window_ends_at_the_failure_and_keeps_labels_inside():
+    """The automatic time window covers the strong motion and every event but stops after a
+    failure (nothing is computed beyond it), and the theta_c label sits inside the panel."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import numpy as np
+
+    from shipblock import ShipBlockSystem, simulate
+    from shipblock.plot import active_window, plot_response
+
+    t = np.arange(0, 60, 0.01)
+    acc = np.where((t > 5) & (t < 50), 1.0, 0.02) * np.sin(2 * np.pi * 1.5 * t)
+    # without an end the window covers the strong motion; with one it stops there
+    t0, t1 = active_window(t, acc, margin=2.0)
+    assert t0 < 6 and t1 > 48
+    assert active_window(t, acc, margin=2.0, end=20.0)[1] == 20.0 + 3.0
+    system = ShipBlockSystem(ship_mass=1e-6, block_mass=1000.0, n_blocks=1, half_width=0.2,
+                             half_height=1.0, mu_s_ground=10, mu_k_ground=10, mu_s_ship=10,
+                             mu_k_ship=10)
+    res = simulate(system, 6.0 * np.sign(np.sin(2 * np.pi * 0.5 * t)) * (t > 5), None, 0.01)
+    assert res.failure == "overturning"
+    axes = plot_response(res)
+    lo, hi = axes[0].get_xlim()
+    assert lo <= 5 and hi <= res.failure_time + 3.0 + 1e-9
+    # the label's x is a fraction of the panel width (y axis transform), so it is inside it
+    label = [txt for txt in axes[2].texts if "overturning" in txt.get_text()]
+    assert len(label) == 1
+    assert label[0].get_transform() == axes[2].get_yaxis_transform()
+    assert 0.0 <= label[0].get_position()[0] <= 1.0
