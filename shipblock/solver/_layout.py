@@ -60,7 +60,9 @@ N_SUMMARY = 25
 
 # Numerical constants (documented in docs/theory/solver.md).
 ROOT_TIME_TOL = 1e-12  # [s] width of the bracket that locates an event
-GUESS_PROBE = 1e-11  # [s] offset of the second trial after an interpolated first guess
+# [s] offset of the second trial after an interpolated first guess: half ROOT_TIME_TOL, so a
+# good guess closes the bracket at once
+GUESS_PROBE = 5e-13
 ONE_SIDED_DT = 1e-8  # [s] candidate modes are checked this long after an event
 FORCE_TOL = 1e-10  # [-] tolerance on force margins, relative to the weight
 ACC_TOL = 1e-10  # [-] a new motion must accelerate by more than this times g
