@@ -161,7 +161,7 @@ def simulate(
                              f"{system.critical_angle:.6g} rad")
     p = system.to_parameter_vector()
     n = ax.size
-    hist = np.empty((n, K.N_HIST))
+    hist = np.empty((K.N_HIST, n))  # one contiguous row per history
     modes = np.empty(n, dtype=np.int64)
     summary = np.empty(K.N_SUMMARY)
     ev_t, ev_k, ev_f, ev_to = K.run(
@@ -169,14 +169,14 @@ def simulate(
         summary, y_init,
     )
     time = np.arange(n) * float(dt)
-    theta = hist[:, K.Y_TH]
-    vb, om, vs = hist[:, K.Y_VB], hist[:, K.Y_OM], hist[:, K.Y_VS]
+    theta = hist[K.Y_TH]
+    vb, om, vs = hist[K.Y_VB], hist[K.Y_OM], hist[K.Y_VS]
     energy = Energy(
-        input_work=hist[:, K.Y_WIN].copy(),
-        kinetic=hist[:, K.H_KIN].copy(),
-        potential=hist[:, K.H_POT].copy(),
-        friction=hist[:, K.Y_DIS].copy(),
-        impact=hist[:, K.Y_IMP].copy(),
+        input_work=hist[K.Y_WIN],
+        kinetic=hist[K.H_KIN],
+        potential=hist[K.H_POT],
+        friction=hist[K.Y_DIS],
+        impact=hist[K.Y_IMP],
     )
     events = EventLog(ev_t, ev_k, ev_f, ev_to)
     summ = _summary_dict(summary, system)
@@ -192,12 +192,12 @@ def simulate(
     fail = failure_name(summary[K.S_FAILURE])
     return SimulationResult(
         time=time,
-        x_b=hist[:, K.Y_XB].copy(),
-        theta=theta.copy(),
-        x_s=hist[:, K.Y_XS].copy(),
-        v_b=vb.copy(),
-        theta_dot=om.copy(),
-        v_s=vs.copy(),
+        x_b=hist[K.Y_XB],
+        theta=theta,
+        x_s=hist[K.Y_XS],
+        v_b=vb,
+        theta_dot=om,
+        v_s=vs,
         mode=modes,
         events=events,
         failure=fail,

@@ -34,7 +34,6 @@ from shipblock.equations import (
     I_XB_DD,
     I_XS_DD,
     kinetic_energy,
-    potential_energy,
     solve_mode,
 )
 from shipblock.modes import MODE_NUMBER
@@ -62,8 +61,6 @@ from shipblock.solver._layout import (
     ROOT_TIME_TOL,
     S_MODE_TIME,
     Y_DIS,
-    Y_OM,
-    Y_TH,
     Y_VB,
     Y_VS,
     Y_WIN,
@@ -329,9 +326,9 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
 
 @njit(cache=True, error_model="numpy")
 def _store(p, y, hist, modes, k, mode):
-    """History row of a non-rocking sample: the state, its energies and the mode."""
+    """History column of a non-rocking sample (theta = 0): the state, its energies and mode."""
     for i in range(N_STATE):
-        hist[k, i] = y[i]
-    hist[k, H_KIN] = kinetic_energy(p, y[Y_TH], 1.0, 0, y[Y_VB], y[Y_OM], y[Y_VS])
-    hist[k, H_POT] = potential_energy(p, y[Y_TH])
+        hist[i, k] = y[i]
+    hist[H_KIN, k] = kinetic_energy(p, 0.0, 1.0, 0, y[Y_VB], 0.0, y[Y_VS])
+    hist[H_POT, k] = 0.0  # theta = 0: the potential energy's reference
     modes[k] = mode

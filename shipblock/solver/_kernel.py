@@ -580,7 +580,8 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     zeno_omega : float
         Rocking stops when an impact leaves less than this angular velocity [rad/s].
     store : bool
-        Fill ``hist`` (n x N_HIST: state, kinetic and potential energy) and ``modes`` (n).
+        Fill ``hist`` (N_HIST x n: state, kinetic and potential energy, one row per quantity so
+        each history is contiguous) and ``modes`` (n).
     hist, modes : ndarray
         History outputs (ignored unless ``store``).
     summary : ndarray, shape (N_SUMMARY,)
@@ -892,7 +893,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     if failure != 0 and store:
         for j in range(k + 1, n):
             for i in range(N_HIST):
-                hist[j, i] = np.nan
+                hist[i, j] = np.nan
             modes[j] = 0
     summary[S_PEAK_XB] = peak_xb
     summary[S_PEAK_TH] = peak_th
@@ -922,10 +923,10 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
 def store_sample(p, ms, y, hist, modes, k, failed):
     """Write the state, kinetic and potential energy and mode of sample ``k``."""
     for i in range(N_STATE):
-        hist[k, i] = y[i]
+        hist[i, k] = y[i]
     s = float(ms[MS_S]) if ms[MS_ROCK] else 1.0
-    hist[k, H_KIN] = kinetic_energy(p, y[Y_TH], s, ms[MS_ROCK], y[Y_VB], y[Y_OM], y[Y_VS])
-    hist[k, H_POT] = potential_energy(p, y[Y_TH])
+    hist[H_KIN, k] = kinetic_energy(p, y[Y_TH], s, ms[MS_ROCK], y[Y_VB], y[Y_OM], y[Y_VS])
+    hist[H_POT, k] = potential_energy(p, y[Y_TH])
     modes[k] = 0 if failed else mode_number(ms)
 
 
@@ -938,7 +939,7 @@ def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params
     ``offsets[r]:offsets[r+1]``. Only summaries are produced.
     """
     n_cases = case_record.shape[0]
-    empty_hist = np.zeros((0, N_HIST))
+    empty_hist = np.zeros((N_HIST, 0))
     empty_modes = np.zeros(0, dtype=np.int64)
     at_rest = np.zeros(N_DYN)
     for c in prange(n_cases):
