@@ -279,7 +279,7 @@ def event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g, w7):
     return ok
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def event_slope(e, ms, y, w7):
     """Time derivative of the velocity-type event functions (0 for the others)."""
     if e == EV_G_SLIP:
@@ -291,7 +291,7 @@ def event_slope(e, ms, y, w7):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def has_slope(e):
     return e == EV_G_SLIP or e == EV_S_SLIP or e == EV_IMPACT
 
@@ -362,13 +362,13 @@ def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has
     return hi
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def mode_number_of(slip1, rock, slip2):
     """Paper mode number (1..8) of the three interface flags."""
     return MODE_NUMBER[slip1, rock, slip2]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def mode_number(ms):
     """Paper mode number (1..8) of a mode state vector."""
     return mode_number_of(ms[MS_SLIP1], ms[MS_ROCK], ms[MS_SLIP2])
