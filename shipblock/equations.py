@@ -78,7 +78,7 @@ def pivot_geometry(p, theta, s, rock):
     return p[P_H] / p[P_R], p[P_B] / p[P_R]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def solve_mode(p, slip1, rock, slip2, s, sig1, sig2, theta, omega, a, G, out):
     """Accelerations and interface forces in the mode given by three interface flags.
 

@@ -942,10 +942,12 @@ def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params
     empty_hist = np.zeros((N_HIST, 0))
     empty_modes = np.zeros(0, dtype=np.int64)
     at_rest = np.zeros(N_DYN)
+    # a run-time False: a literal would make numba compile ``run`` a second time for it
+    store = n_cases < 0
     for c in prange(n_cases):
         r = case_record[c]
         a0 = offsets[r]
         a1 = offsets[r + 1]
         run(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
-            case_sv[c], dts[r], rtol, atol, zeno_omega, False, empty_hist, empty_modes,
+            case_sv[c], dts[r], rtol, atol, zeno_omega, store, empty_hist, empty_modes,
             summaries[c], at_rest)
