@@ -38,6 +38,7 @@ from shipblock.equations import (
 )
 from shipblock.modes import MODE_NUMBER
 from shipblock.solver._events import event_functions
+from shipblock.solver._ground import ground_motion_at
 from shipblock.solver._layout import (
     EV_G_SLIP,
     EV_G_STICK,
@@ -193,14 +194,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
     for e in range(N_EVENTS):
         if not armed[e]:
             all_armed = False
-    # ground input at the start of the interval (interpolated when tau > 0, as ground_motion_at)
-    f = tau / dt
-    a0 = sh * ax[k]
-    a0 = a0 + (sh * ax[k + 1] - a0) * f
-    b0 = 0.0
-    if has_ay:
-        b0 = sv * ay[k]
-        b0 = b0 + (sv * ay[k + 1] - b0) * f
+    a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # start of the interval
     time_in_mode = 0.0  # accumulated here, added to the summary when the span ends
     while k < n - 1:
         h = dt - tau

@@ -36,6 +36,7 @@ from shipblock.modes import MODE_NUMBER, EventKind, Failure
 from shipblock.solver._closed_form import nonrocking_span
 from shipblock.solver._dopri import DP_A, DP_C, DP_E, DP_ERROR_ORDER
 from shipblock.solver._events import event_functions
+from shipblock.solver._ground import ground_motion_at
 from shipblock.solver._interpolate import (
     bracketed_root,
     hermite_extremum,
@@ -108,27 +109,6 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     parameter_tuple,
 )
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
-
-
-@njit(cache=True)
-def ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt):
-    """Scaled ground acceleration (a, ay) at t_k + tau, linear between samples [m/s^2]."""
-    n = ax.shape[0]
-    while tau > dt and k < n - 2:
-        tau -= dt
-        k += 1
-    if k >= n - 1:
-        b = sv * ay[n - 1] if has_ay else 0.0
-        return sh * ax[n - 1], b
-    # scale the samples first, then interpolate: the same arithmetic as a pre-scaled record
-    f = tau / dt
-    a0 = sh * ax[k]
-    a = a0 + (sh * ax[k + 1] - a0) * f
-    b = 0.0
-    if has_ay:
-        b0 = sv * ay[k]
-        b = b0 + (sv * ay[k + 1] - b0) * f
-    return a, b
 
 
 @njit(cache=True, inline="always")
@@ -292,6 +272,19 @@ def event_slope(e, ms, y, w7):
 
 
 @njit(cache=True, inline="always")
+def start_slope(e, ms, y, acc_b, acc_s):
+    """Slope of a velocity-type event function at the start of a step.
+
+    ``acc_b`` and ``acc_s`` are the slip accelerations there (the step's first stage).
+    """
+    if e == EV_G_SLIP:
+        return ms[MS_SIG1] * acc_b
+    if e == EV_S_SLIP:
+        return ms[MS_SIG2] * acc_s
+    return ms[MS_S] * y[Y_OM]
+
+
+@njit(cache=True, inline="always")
 def has_slope(e):
     return e == EV_G_SLIP or e == EV_S_SLIP or e == EV_IMPACT
 
@@ -411,6 +404,21 @@ def interface_option(v, i):
     return flag, (-1 if i == 2 else 1), flag
 
 
+@njit(cache=True, inline="always")
+def interface_violation(held, excess, new, push):
+    """How much a candidate violates one interface's conditions (0 when it satisfies them).
+
+    A held interface (stick, rest) violates its friction cone or moment criterion by
+    ``excess`` (dimensionless, > ``FORCE_TOL``); a motion that would start must accelerate
+    in its direction, ``push`` (in g) > ``ACC_TOL``.
+    """
+    if held:
+        return excess if excess > FORCE_TOL else 0.0
+    if new and push <= ACC_TOL:
+        return ACC_TOL - push
+    return 0.0
+
+
 @njit(cache=True)
 def candidate_options(idx, vb, rot, vs):
     """Interface options of candidate ``idx`` (0..26): three (flag, sign, new) triples.
@@ -502,30 +510,14 @@ def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7, order
                 all_separate = False
             else:
                 viol += max(0.0, -fy / weight) + max(0.0, -Fy / ship_weight) + 1.0
-            if slip1 == 0:
-                v = (abs(fx) - p[P_MUS1] * fy) / weight
-                if v > FORCE_TOL:
-                    viol += v
-            elif new1:
-                v = sig1 * w7[0] / p[P_G]
-                if v <= ACC_TOL:
-                    viol += ACC_TOL - v
-            if rock == 0:
-                v = (p[P_H] * abs(fx + Fx) - p[P_B] * (fy + Fy)) / (weight * p[P_R])
-                if v > FORCE_TOL:
-                    viol += v
-            elif newr:
-                v = s * w7[1] * p[P_R] / p[P_G]
-                if v <= ACC_TOL:
-                    viol += ACC_TOL - v
-            if slip2 == 0:
-                v = (abs(Fx) - p[P_MUS2] * Fy) / ship_weight
-                if v > FORCE_TOL:
-                    viol += v
-            elif new2:
-                v = sig2 * w7[2] / p[P_G]
-                if v <= ACC_TOL:
-                    viol += ACC_TOL - v
+            # ground, rocking, ship: the constraint held, or the new motion's push
+            viol += interface_violation(
+                slip1 == 0, (abs(fx) - p[P_MUS1] * fy) / weight, new1, sig1 * w7[0] / p[P_G])
+            viol += interface_violation(
+                rock == 0, (p[P_H] * abs(fx + Fx) - p[P_B] * (fy + Fy)) / (weight * p[P_R]),
+                newr, s * w7[1] * p[P_R] / p[P_G])
+            viol += interface_violation(
+                slip2 == 0, (abs(Fx) - p[P_MUS2] * Fy) / ship_weight, new2, sig2 * w7[2] / p[P_G])
             if viol == 0.0:
                 # the most preferred consistent candidate: the choice
                 ms[0], ms[1], ms[2], ms[3], ms[4], ms[5] = slip1, rock, slip2, s, sig1, sig2
@@ -722,12 +714,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
                         # started on the boundary: look for the interior maximum first
                         g_lo = 0.0
                         if has_slope(e):
-                            if e == EV_G_SLIP:
-                                d0 = ms[MS_SIG1] * d_start_b
-                            elif e == EV_S_SLIP:
-                                d0 = ms[MS_SIG2] * d_start_s
-                            else:
-                                d0 = ms[MS_S] * y[Y_OM]
+                            d0 = start_slope(e, ms, y, d_start_b, d_start_s)
                             d1 = event_slope(e, ms, y1, w7b)
                             u, _ = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
                             if u > 0.0:
@@ -737,12 +724,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
                                     lo = u * h
                                     g_lo = gm
                 elif has_slope(e) and g0[e] > 0.0:
-                    if e == EV_G_SLIP:
-                        d0 = ms[MS_SIG1] * d_start_b
-                    elif e == EV_S_SLIP:
-                        d0 = ms[MS_SIG2] * d_start_s
-                    else:
-                        d0 = ms[MS_S] * y[Y_OM]
+                    d0 = start_slope(e, ms, y, d_start_b, d_start_s)
                     d1 = event_slope(e, ms, y1, w7b)
                     if d0 < 0.0 and d1 > 0.0:
                         u, vmin = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
