@@ -164,9 +164,9 @@ def batch_scaling(system, records, scale, n_copies=8):
     n_threads = numba.config.NUMBA_NUM_THREADS
     numba.set_num_threads(1)
     simulate_batch(system, recs, dts, cases[:1])
-    t1, r1 = _time(lambda: simulate_batch(system, recs, dts, cases), repeat=2)
+    t1, r1 = _time(lambda: simulate_batch(system, recs, dts, cases), repeat=3)
     numba.set_num_threads(n_threads)
-    tn, rn = _time(lambda: simulate_batch(system, recs, dts, cases), repeat=2)
+    tn, rn = _time(lambda: simulate_batch(system, recs, dts, cases), repeat=3)
     identical = all(np.array_equal(r1[k], rn[k], equal_nan=True) for k in r1)
     return {"cores": n_threads, "cases": len(cases), "seconds_1": t1, "seconds_n": tn,
             "speedup": t1 / tn, "identical": identical, "runs_per_s": len(cases) / tn}
