@@ -142,8 +142,10 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
 
     Parameters
     ----------
-    p, ms, y : ndarray
-        Parameters, mode state and state (``y`` is updated in place).
+    p : tuple of float
+        Parameters (:func:`~shipblock.solver._layout.parameter_tuple`).
+    ms, y : ndarray
+        Mode state and state (``y`` is updated in place).
     k, tau : int, float
         Current sample interval and time into it [s].
     dt, ax, ay, has_ay, sh, sv
