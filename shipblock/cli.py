@@ -297,7 +297,11 @@ def cmd_run(args):
         for ls in ds["limit_state"].values:
             med = ds["median"].sel(limit_state=ls)
             beta = ds["beta"].sel(limit_state=ls)
-            if med.ndim == 0:
+            error = str(ds["fit_error"].sel(limit_state=ls).values) if "fit_error" in ds else ""
+            if med.ndim == 0 and error:
+                # e.g. too few exceedances to identify beta: say why instead of printing nan
+                out.write(f"  {str(ls):<24} not fitted: {error.split(': ', 1)[-1]}\n")
+            elif med.ndim == 0:
                 value, label, _ = _im_axis(ds, [float(med)])
                 band = ""
                 if "median_lower" in ds:

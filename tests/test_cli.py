@@ -128,3 +128,21 @@ def test_response_figure_window_ends_at_the_failure_and_keeps_labels_inside():
     assert len(label) == 1
     assert label[0].get_transform() == axes[2].get_yaxis_transform()
     assert 0.0 <= label[0].get_position()[0] <= 1.0
+
+
+def test_run_says_why_a_limit_state_was_not_fitted(tmp_path, capsys):
+    """A limit state whose fit failed (e.g. beta not identified) is reported with the reason
+    kept in the dataset's fit_error, never as a 'nan' median."""
+    nc = tmp_path / "napa.nc"
+    code, out, _ = run(capsys, "run", "pipelines/napa_ida.toml", "--output", str(nc))
+    assert code == 0, out
+    ds = xr.open_dataset(nc)
+    lines = out.split("fitted fragility (lognormal):\n", 1)[1].splitlines()
+    for ls in ds["limit_state"].values:
+        line = next(x for x in lines if x.strip().startswith(f"{ls} "))
+        error = str(ds["fit_error"].sel(limit_state=ls).values)
+        assert "nan" not in line
+        if error:
+            assert "not fitted: " in line and error.split(": ", 1)[-1] in line
+        else:
+            assert "median" in line
