@@ -14,10 +14,9 @@ samples a and G are linear in time, so within a sample interval
 
 :func:`nonrocking_span` runs this loop over as many samples as the mode lasts without leaving
 compiled code or touching the general event machinery, which is what makes sliding and rest
-phases cheap (a few nanoseconds per sample at rest). It stops at the first event, leaving the
-state at the start of that sample interval and returning the event and its time within it; the
-general kernel then advances there and applies the event. The results agree with the general
-step-and-locate path to rounding: both integrate the same polynomials.
+phases cheap (a few nanoseconds per sample at rest). It stops at the first event, with the
+state advanced exactly to it (the same polynomials, cut at the root), and returns the event for
+the general kernel to apply.
 """
 
 from __future__ import annotations
@@ -135,6 +134,35 @@ def quadratic_root(q0, d0, c, h):
     return best
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M):
+    """Advance ``y`` by ``h`` with slip accelerations, ground acceleration and friction forces
+    linear in time from their values at 0 (``*0``) to those at ``h`` (``*1``).
+
+    Velocities are quadratic and slips cubic in time; the input power -a P_x and the friction
+    dissipation rate -(fx v_b + Fx v_s) are cubic, so Simpson's rule integrates them exactly.
+    """
+    vb0 = y[Y_VB]
+    vs0 = y[Y_VS]
+    vb1 = vb0 + 0.5 * h * (ub0 + ub1)
+    vs1 = vs0 + 0.5 * h * (us0 + us1)
+    vbm = vb0 + 0.5 * h * ub0 + 0.125 * h * (ub1 - ub0)
+    vsm = vs0 + 0.5 * h * us0 + 0.125 * h * (us1 - us0)
+    am = 0.5 * (a0 + a1)
+    r0 = -a0 * (mass_b * vb0 + M * vs0)
+    rm = -am * (mass_b * vbm + M * vsm)
+    r1 = -a1 * (mass_b * vb1 + M * vs1)
+    d0 = -(fx0 * vb0 + Fx0 * vs0)
+    dm = -(0.5 * (fx0 + fx1) * vbm + 0.5 * (Fx0 + Fx1) * vsm)
+    d1 = -(fx1 * vb1 + Fx1 * vs1)
+    y[Y_XB] += h * vb0 + h * h * (2.0 * ub0 + ub1) / 6.0
+    y[Y_XS] += h * vs0 + h * h * (2.0 * us0 + us1) / 6.0
+    y[Y_VB] = vb1
+    y[Y_VS] = vs1
+    y[Y_WIN] += h * (r0 + 4.0 * rm + r1) / 6.0
+    y[Y_DIS] += h * (d0 + 4.0 * dm + d1) / 6.0
+
+
 @njit(cache=True, error_model="numpy")
 def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary, peaks,
                     store, hist, modes, resp, g):
@@ -166,12 +194,10 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
     Returns
     -------
     k, tau : int, float
-        Where the span stopped: the start of the sample interval holding the event, or the
-        end of the record.
+        Where the span stopped: at the event (``y`` is the state there and its time has been
+        counted in the summary), or at the end of the record.
     event : int
         The event (``EV_*``), -1 at the end of the record, -2 if the mode is singular.
-    h_event : float
-        Time of the event after ``tau`` [s].
     """
     n = ax.shape[0]
     slip1, slip2 = ms[MS_SLIP1], ms[MS_SLIP2]
@@ -181,7 +207,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
     ok_a = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
     ok_g = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)
     if not (ok_a and ok_g):
-        return k, tau, -2, 0.0
+        return k, tau, -2
     ub_a, us_a, fx_a, fy_a, Fx_a, Fy_a = wa[I_XB_DD], wa[I_XS_DD], wa[I_FX], wa[I_FY], wa[I_SFX], wa[I_SFY]
     ub_g, us_g, fx_g, fy_g, Fx_g, Fy_g = wg[I_XB_DD], wg[I_XS_DD], wg[I_FX], wg[I_FY], wg[I_SFX], wg[I_SFY]
     grav = p[P_G]
@@ -272,28 +298,16 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
                     best_h = r
                     best_e = e
             if best_e >= 0:
-                summary[mode_slot] += time_in_mode
-                return k, tau, best_e, best_h
+                # advance to the event: the same polynomials, cut at best_h (u = best_h / h)
+                u = best_h / h
+                exact_update(y, best_h, ub0, ub0 + (ub1 - ub0) * u, us0, us0 + (us1 - us0) * u,
+                             a0, a0 + (a1 - a0) * u, fx0, fx0 + (fx1 - fx0) * u, Fx0,
+                             Fx0 + (Fx1 - Fx0) * u, mass_b, M)
+                summary[mode_slot] += time_in_mode + best_h
+                return k, tau + best_h, best_e
         # no event: advance exactly to the next sample
         if slip1 or slip2 or vb0 != 0.0 or vs0 != 0.0:
-            vb1 = vb0 + 0.5 * h * (ub0 + ub1)
-            vs1 = vs0 + 0.5 * h * (us0 + us1)
-            vbm = vb0 + 0.5 * h * ub0 + 0.125 * h * (ub1 - ub0)
-            vsm = vs0 + 0.5 * h * us0 + 0.125 * h * (us1 - us0)
-            am = 0.5 * (a0 + a1)
-            # input power -a P_x and friction dissipation -(fx vb + Fx vs), cubic: Simpson
-            r0 = -a0 * (mass_b * vb0 + M * vs0)
-            rm = -am * (mass_b * vbm + M * vsm)
-            r1 = -a1 * (mass_b * vb1 + M * vs1)
-            d0 = -(fx0 * vb0 + Fx0 * vs0)
-            dm = -(0.5 * (fx0 + fx1) * vbm + 0.5 * (Fx0 + Fx1) * vsm)
-            d1 = -(fx1 * vb1 + Fx1 * vs1)
-            y[Y_XB] += h * vb0 + h * h * (2.0 * ub0 + ub1) / 6.0
-            y[Y_XS] += h * vs0 + h * h * (2.0 * us0 + us1) / 6.0
-            y[Y_VB] = vb1
-            y[Y_VS] = vs1
-            y[Y_WIN] += h * (r0 + 4.0 * rm + r1) / 6.0
-            y[Y_DIS] += h * (d0 + 4.0 * dm + d1) / 6.0
+            exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M)
             axb = abs(y[Y_XB])
             if axb > peaks[0]:
                 peaks[0] = axb
@@ -317,7 +331,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
         if store:
             _store(p, y, hist, modes, k, MODE_NUMBER[slip1, 0, slip2])
     summary[mode_slot] += time_in_mode
-    return k, tau, -1, 0.0
+    return k, tau, -1
 
 
 @njit(cache=True, error_model="numpy")

@@ -133,84 +133,22 @@ def rhs(p, ms, y, a, ay, stages, st, w7):
     return ok
 
 
-@njit(cache=True)
-def is_static(ms, y):
-    """True in mode 1 with all velocities zero: the state does not change."""
-    return (
-        ms[MS_SLIP1] == 0 and ms[MS_ROCK] == 0 and ms[MS_SLIP2] == 0
-        and y[Y_VB] == 0.0 and y[Y_OM] == 0.0 and y[Y_VS] == 0.0
-    )
-
-
-@njit(cache=True)
-def advance_polynomial(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages):
-    """Exact advance in a non-rocking mode: accelerations are linear in time within a sample.
-
-    Two solves (at both ends) give u(t) exactly; velocities are quadratic and displacements
-    cubic in time, and the input power and friction dissipation rate are cubic, so Simpson's
-    rule integrates them exactly. The solves are left in ``stages[0]`` and ``stages[1]``.
-    """
-    a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)
-    a1, b1 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + h, dt)
-    w0 = stages[0]
-    w1 = stages[1]
-    g = p[P_G]
-    ok0 = solve_mode(p, ms[MS_SLIP1], 0, ms[MS_SLIP2], 1.0, float(ms[MS_SIG1]),
-                     float(ms[MS_SIG2]), 0.0, 0.0, a0, g + b0, w0)
-    ok1 = solve_mode(p, ms[MS_SLIP1], 0, ms[MS_SLIP2], 1.0, float(ms[MS_SIG1]),
-                     float(ms[MS_SIG2]), 0.0, 0.0, a1, g + b1, w1)
-    if not (ok0 and ok1):
-        return -1.0
-    ub0, us0 = w0[0], w0[2]
-    ub1, us1 = w1[0], w1[2]
-    vb0, vs0 = y0[Y_VB], y0[Y_VS]
-    y1[Y_TH] = y0[Y_TH]
-    y1[Y_OM] = y0[Y_OM]
-    y1[Y_XB] = y0[Y_XB] + h * vb0 + h * h * (2.0 * ub0 + ub1) / 6.0
-    y1[Y_XS] = y0[Y_XS] + h * vs0 + h * h * (2.0 * us0 + us1) / 6.0
-    y1[Y_VB] = vb0 + 0.5 * h * (ub0 + ub1)
-    y1[Y_VS] = vs0 + 0.5 * h * (us0 + us1)
-    vbm = vb0 + 0.5 * h * ub0 + 0.125 * h * (ub1 - ub0)
-    vsm = vs0 + 0.5 * h * us0 + 0.125 * h * (us1 - us0)
-    mass_b = p[P_NM] + p[P_M]
-    M = p[P_M]
-    am = 0.5 * (a0 + a1)
-    # input power -a P_x (P_y = 0 without rocking) and friction dissipation -(fx vb + Fx vs)
-    r0 = -a0 * (mass_b * vb0 + M * vs0)
-    rm = -am * (mass_b * vbm + M * vsm)
-    r1 = -a1 * (mass_b * y1[Y_VB] + M * y1[Y_VS])
-    y1[Y_WIN] = y0[Y_WIN] + h * (r0 + 4.0 * rm + r1) / 6.0
-    fxm = 0.5 * (w0[I_FX] + w1[I_FX])
-    sfxm = 0.5 * (w0[I_SFX] + w1[I_SFX])
-    d0 = -(w0[I_FX] * vb0 + w0[I_SFX] * vs0)
-    dm = -(fxm * vbm + sfxm * vsm)
-    d1 = -(w1[I_FX] * y1[Y_VB] + w1[I_SFX] * y1[Y_VS])
-    y1[Y_DIS] = y0[Y_DIS] + h * (d0 + 4.0 * dm + d1) / 6.0
-    y1[Y_IMP] = y0[Y_IMP]
-    # first-stage slopes in the layout the event code reads
-    stages[0, Y_VB] = ub0
-    stages[0, Y_VS] = us0
-    return 0.0
-
-
 @njit(cache=True, inline="always")
 def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
             first_stage_known=False):
-    """Advance ``y0`` by ``h`` within sample interval ``k``; returns 0, or -1 if singular.
+    """One Dormand-Prince 5(4) step of ``h`` within sample interval ``k``: 0, or -1 if singular.
 
-    Rest: the state does not change. Sliding (no rocking): exact polynomial update. Rocking:
-    one Dormand-Prince 5(4) step (its error estimate is read from ``stages`` by
-    :func:`error_norm`); with ``first_stage_known`` the first stage, f(t, y0), is taken from
-    ``stages[0]`` as left there by the previous step (first same as last) or by an earlier
-    step from the same ``y0``.
+    Used for rocking modes (rest and sliding are advanced in closed form by
+    :func:`~shipblock.solver._closed_form.nonrocking_span`). The error estimate is read from
+    ``stages`` by :func:`error_norm`. With ``first_stage_known`` the first stage, f(t, y0), is
+    taken from ``stages[0]`` as left there by the previous step (first same as last) or by an
+    earlier step from the same ``y0``.
     """
     n = y0.shape[0]
-    if is_static(ms, y0) or h == 0.0:
+    if h == 0.0:
         for i in range(n):
             y1[i] = y0[i]
         return 0.0
-    if ms[MS_ROCK] == 0:
-        return advance_polynomial(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages)
     # the step stays within sample interval k, where the input is linear in time
     # (the same arithmetic as ground_motion_at)
     a0 = sh * ax[k]
@@ -653,7 +591,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
             peaks[0] = peak_xb
             peaks[1] = peak_xs
             k_before = k
-            k, tau, best_e, best_h = nonrocking_span(
+            k, tau, best_e = nonrocking_span(
                 p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary, peaks, store,
                 hist, modes, resp, gw)
             peak_xb = peaks[0]
@@ -774,14 +712,15 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
                     grow = SAFETY * max(err, 1e-10) ** (-1.0 / (DP_ERROR_ORDER + 1))
                     h_rock = h * min(MAX_FACTOR, max(MIN_FACTOR, grow))
         if best_e >= 0:
-            # advance to the event and apply it
-            advance(p, ms, y, k, tau, best_h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
-                    fsal)
+            # advance to the event (the closed-form span has done so already) and apply it
+            if ms[MS_ROCK]:
+                advance(p, ms, y, k, tau, best_h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp,
+                        w7, fsal)
+                for i in range(N_STATE):
+                    y[i] = y1[i]
+                summary[S_MODE_TIME + mode_number(ms) - 1] += best_h
+                tau += best_h
             fsal = False
-            for i in range(N_STATE):
-                y[i] = y1[i]
-            summary[S_MODE_TIME + mode_number(ms) - 1] += best_h
-            tau += best_h
             t_now = k * dt + tau
             from_mode = mode_number(ms)
             trigger = -1
