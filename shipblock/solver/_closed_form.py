@@ -135,6 +135,18 @@ def quadratic_root(q0, d0, c, h):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def slip_may_stop(sig, v0, u0, u1, h):
+    """Whether a slip velocity, quadratic over the interval, may reach zero inside it.
+
+    ``sig v`` starts at ``sig v0`` with slope ``sig u0``; it is suspect if it ends negative or
+    if its slope turns from negative to positive inside (a dip, checked exactly afterwards).
+    """
+    c = sig * (u1 - u0) / (2.0 * h)
+    d0 = sig * u0
+    return sig * v0 + h * (d0 + c * h) < 0.0 or (d0 < 0.0 and d0 + 2.0 * c * h > 0.0)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M):
     """Advance ``y`` by ``h`` with slip accelerations, ground acceleration and friction forces
     linear in time from their values at 0 (``*0``) to those at ``h`` (``*1``).
@@ -249,18 +261,10 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
         # quadratic and can also dip below zero inside. Only a suspect interval is searched.
         suspect = not all_armed or fy1 <= 0.0 or Fy1 <= 0.0 \
             or B * (fy1 + Fy1) < H * abs(fx1 + Fx1)
-        if slip1:
-            cb = sig1 * (ub1 - ub0) / (2.0 * h)
-            suspect = suspect or sig1 * vb0 + h * (sig1 * ub0 + cb * h) < 0.0 \
-                or (sig1 * ub0 < 0.0 and sig1 * ub0 + 2.0 * cb * h > 0.0)
-        else:
-            suspect = suspect or mus1 * fy1 < abs(fx1)
-        if slip2:
-            cs = sig2 * (us1 - us0) / (2.0 * h)
-            suspect = suspect or sig2 * vs0 + h * (sig2 * us0 + cs * h) < 0.0 \
-                or (sig2 * us0 < 0.0 and sig2 * us0 + 2.0 * cs * h > 0.0)
-        else:
-            suspect = suspect or mus2 * Fy1 < abs(Fx1)
+        # each interface: a slip that may stop, or a stick force leaving its friction cone
+        ground = slip_may_stop(sig1, vb0, ub0, ub1, h) if slip1 else mus1 * fy1 < abs(fx1)
+        ship = slip_may_stop(sig2, vs0, us0, us1, h) if slip2 else mus2 * Fy1 < abs(Fx1)
+        suspect = suspect or ground or ship
         if suspect:
             best_h = h + 1.0
             best_e = -1
