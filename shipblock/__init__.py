@@ -36,6 +36,7 @@ _LAZY = {
     "processing": "shipblock.processing",
     "scaling": "shipblock.scaling",
     "run_pipeline": "shipblock.fragility.pipeline",
+    "rerun_case": "shipblock.fragility.pipeline",
 }
 
 

@@ -1,4 +1,4 @@
-"""The ``shipblock`` command: simulate, process, info, run, plot, bench.
+"""The ``shipblock`` command: simulate, process, info, run, history, plot, bench.
 
 The command only parses arguments, calls the library and prints; every computation lives in the
 library. User errors print one line ``shipblock: error: ...`` and exit with status 2.
@@ -121,8 +121,6 @@ def _system_from_args(args):
 
 
 def cmd_simulate(args):
-    import numpy as np
-
     from shipblock.solver import simulate
 
     system = _system_from_args(args)
@@ -133,11 +131,43 @@ def cmd_simulate(args):
         ay = motion.vertical * (args.scale if args.vertical_scale is None else args.vertical_scale)
     log.info("simulating %d samples at dt = %g s", ax.size, motion.dt)
     res = simulate(system, ax, ay, motion.dt, rtol=args.rtol)
-    out = sys.stdout
     name = motion.name
+    _report(res, name, args.events)
+    if args.output:
+        ds = res.to_dataset()
+        ds.attrs["record"] = str(name)
+        ds.attrs["processing"] = "\n".join(motion.metadata.get("processing", []) or [])
+        _write_response(ds, args.output)
+    _response_figure_option(res, name, args.figure, args.output)
+    return 0
+
+
+def _write_response(ds, output):
+    from shipblock.fragility.store import write_dataset
+
+    write_dataset(ds, output)
+    sys.stdout.write(f"response written to {output}\n")
+
+
+def _response_figure_option(res, name, figure, output):
+    if figure is None and output:
+        figure = str(Path(output).with_suffix(".png"))
+    if figure:
+        _save_figure(lambda: _response_figure(res, name), figure)
+        sys.stdout.write(f"figure written to {figure}\n")
+
+
+def _report(res, name, max_events):
+    """Print the summary of a simulation: record, system, failure, peaks, modes, events."""
+    import numpy as np
+
+    out = sys.stdout
+    system = res.system
+    ax = res.ground_acceleration[0]
+    dt = float(res.time[1] - res.time[0])
     s = res.summary
     rows = [
-        ("record", f"{name} ({ax.size} samples, dt = {motion.dt:g} s, "
+        ("record", f"{name} ({ax.size} samples, dt = {dt:g} s, "
                    f"PGA_H = {np.abs(ax).max() / STANDARD_GRAVITY:.3f} g)"),
         ("system", f"M = {system.ship_mass:.4g} kg on {system.n_blocks} blocks of "
                    f"{system.block_mass:.4g} kg, 2B x 2H = {2 * system.half_width:g} x "
@@ -165,33 +195,63 @@ def cmd_simulate(args):
     for e in res.events[1:]:
         counts[e.kind] = counts.get(e.kind, 0) + 1
     out.write("events: " + (", ".join(f"{k} {v}" for k, v in sorted(counts.items())) or "none") + "\n")
-    shown = [e for e in res.events[1:] if e.kind != "impact"][: args.events]
+    shown = [e for e in res.events[1:] if e.kind != "impact"][:max_events]
     for e in shown:
         out.write(f"  t = {e.time:10.5f} s  {e.kind:<18} mode {e.from_mode} -> {e.to_mode}\n")
+
+
+def _parse_assignments(items):
+    """``["mu_ground=0.4", ...]`` -> ``{"mu_ground": 0.4}`` (numbers only)."""
+    values = {}
+    for item in items or []:
+        name, sep, text = item.partition("=")
+        if not sep or not name.strip():
+            raise UserError(f"--set expects NAME=VALUE, got {item!r}")
+        try:
+            values[name.strip()] = float(text)
+        except ValueError:
+            raise UserError(f"--set {name.strip()}: {text!r} is not a number") from None
+    return values
+
+
+def cmd_history(args):
+    from shipblock.fragility.pipeline import _rerun
+
+    if args.im_level is not None and args.im_level_g is not None:
+        raise UserError("give --im-level or --im-level-g, not both")
+    ds, res = _rerun(args.pipeline, args.record, im_level=args.im_level,
+                     im_level_g=args.im_level_g, **_parse_assignments(args.set))
+    name = ds.attrs["record"]
+    level = ""
+    if "im_level" in ds.attrs:
+        level = f" at {ds.attrs['im_level']:.4g} {ds.attrs['im_units']}"
+    sys.stdout.write(f"run {ds.attrs['case']} of {args.pipeline}: {name}{level}, scale factor "
+                     f"{ds.attrs['scale_factor']:.4g}\n")
+    _report(res, name, args.events)
     if args.output:
-        path = Path(args.output)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        ds = res.to_dataset()
-        ds.attrs["record"] = str(name)
-        ds.attrs["processing"] = "\n".join(motion.metadata.get("processing", []) or [])
-        tmp = path.with_name(path.name + ".part")
-        ds.to_netcdf(tmp, engine="netcdf4")
-        tmp.replace(path)
-        out.write(f"response written to {path}\n")
-    figure = args.figure
-    if figure is None and args.output:
-        figure = str(Path(args.output).with_suffix(".png"))
-    if figure:
-        _save_figure(lambda: _response_figure(res, name), figure)
-        out.write(f"figure written to {figure}\n")
+        _write_response(ds, args.output)
+    _response_figure_option(res, name, args.figure, args.output)
     return 0
+
+
+def _run_name(ds):
+    """Title of a saved response: its record and, for a run of a batch, its IM level."""
+    name = ds.attrs.get("record", "")
+    if name and "im_level" in ds.attrs:
+        value, unit = float(ds.attrs["im_level"]), ds.attrs.get("im_units", "")
+        if unit == "m/s^2":
+            value, unit = value / STANDARD_GRAVITY, "g"
+        measure = ds.attrs.get("im_measure", "IM").upper().replace("SA", "Sa")
+        name += f", {measure} {value:.3g} {unit}"
+    return name
 
 
 def _response_figure(res, name):
     from shipblock.plot import plot_response
 
     axes = plot_response(res)
-    axes[0].figure.suptitle(f"{name}: " + axes[0].figure._suptitle.get_text())
+    if name:
+        axes[0].figure.suptitle(f"{name}: " + axes[0].figure._suptitle.get_text())
     return axes[0].figure
 
 
@@ -312,6 +372,11 @@ def cmd_run(args):
                           f"beta {float(beta):.3f}\n")
             else:
                 out.write(f"  {str(ls):<24} fitted per swept parameter (see the NetCDF)\n")
+    if "history_file" in ds:
+        n = int((ds["history_file"] != "").sum())
+        folder = Path(ds.encoding.get("source", ".")).parent / ds.attrs["histories_directory"]
+        out.write(f"{n} time histories written to {folder} "
+                  "(listed in the variable history_file; draw one with 'shipblock plot')\n")
     if args.figure:
         from shipblock.plot import plot_fragility
 
@@ -327,9 +392,7 @@ def cmd_plot(args):
         ds = ds.load()
     figure = args.figure or str(Path(args.results).with_suffix(".png"))
     if "x_b" in ds and "time" in ds.dims:
-        from shipblock.plot import plot_response
-
-        _save_figure(lambda: plot_response(ds)[0].figure, figure)
+        _save_figure(lambda: _response_figure(ds, _run_name(ds)), figure)
     elif "median" in ds and args.kind == "ida":
         from shipblock.plot import plot_ida
 
@@ -402,6 +465,22 @@ def build_parser():
     s.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
     s.add_argument("--figure", help="PNG of the fragility curves")
     s.set_defaults(func=cmd_run)
+
+    s = sub.add_parser("history", help="full time histories of one run of a pipeline",
+                       description="Simulate one run of a pipeline again (same record, "
+                                   "processing, scaling, system and solver options as in the "
+                                   "batch) and print, write and plot its full response.")
+    s.add_argument("pipeline", help="pipeline TOML, e.g. pipelines/demo.toml")
+    s.add_argument("--record", required=True, help="record id, e.g. NP.1765")
+    s.add_argument("--im-level-g", type=float, help="IM level of the run [g] (PGA, Sa)")
+    s.add_argument("--im-level", type=float,
+                   help="IM level of the run in SI units of the measure (m/s^2; m/s for PGV)")
+    s.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help="value of a swept parameter, e.g. --set mu_ground=0.4 (repeatable)")
+    s.add_argument("--output", "-o", help="NetCDF file for the response")
+    s.add_argument("--figure", help="PNG for the response figure (default: next to --output)")
+    s.add_argument("--events", type=int, default=20, help="list at most this many events")
+    s.set_defaults(func=cmd_history)
 
     s = sub.add_parser("plot", help="figure from a results NetCDF (response or fragility)")
     s.add_argument("results", help="NetCDF written by 'simulate' or 'run'")

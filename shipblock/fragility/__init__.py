@@ -68,11 +68,22 @@ __all__ += [
     "run_chunk",
     "write_dataset",
 ]
+from shipblock.fragility.histories import (  # noqa: E402
+    SelectionError,
+    case_number,
+    run_case,
+    select_cases,
+    write_histories,
+)
 from shipblock.fragility.pipeline import (  # noqa: E402
+    HistoryRequest,
     PipelineError,
     load_pipeline,
     parse_pipeline,
+    rerun_case,
     run_pipeline,
 )
 
-__all__ += ["PipelineError", "load_pipeline", "parse_pipeline", "run_pipeline"]
+__all__ += ["HistoryRequest", "PipelineError", "SelectionError", "case_number", "load_pipeline",
+            "parse_pipeline", "rerun_case", "run_case", "run_pipeline", "select_cases",
+            "write_histories"]

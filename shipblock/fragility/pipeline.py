@@ -60,6 +60,18 @@ Schema (``schema_version = 1``; units in brackets, paths relative to the pipelin
     chunk_size = 1024                   # cases per chunk (part of the run's identity)
     scheduler = "tcp://host:8786"       # optional Dask scheduler
 
+    [histories]                         # optional: full time histories of some runs
+    runs = [{record = "NP.1765", im_level_g = 0.8}]   # selectors (see below)
+    exceeding = ["ship_slip"]           # and every run exceeding one of these limit states
+    max_runs = 100                      # at most this many files (selectors first)
+    directory = "results/demo_histories"  # default: <output stem>_histories/ beside the output
+
+A selector names a record (catalogue id or its last part) and optionally ``im_level`` [SI] or
+``im_level_g`` [g] and values of swept parameters; what it leaves out, it takes all of
+(:mod:`shipblock.fragility.histories`). The histories are computed after the batch by
+:func:`shipblock.simulate` on the batch's own input, one NetCDF file per run, and are listed in
+the result's ``history_file`` variable.
+
 IM levels are converted to SI once, here: ``levels_g`` multiplies by
 :data:`shipblock.units.STANDARD_GRAVITY`; ``levels`` with ``units`` goes through
 :func:`shipblock.units.acceleration_to_si` (a velocity unit ``"X/s"`` for PGV uses the length
@@ -106,6 +118,14 @@ from shipblock.fragility.fit import (
     fit_msa,
     ida_capacities,
 )
+from shipblock.fragility.histories import (
+    SelectionError,
+    case_dataset,
+    case_number,
+    run_case,
+    select_cases,
+    write_histories,
+)
 from shipblock.fragility.limit_states import (
     EDP_VARIABLES,
     LimitState,
@@ -119,11 +139,13 @@ from shipblock.units import ACCELERATION_UNITS_TO_SI, STANDARD_GRAVITY, accelera
 
 __all__ = [
     "SCHEMA_VERSION",
+    "HistoryRequest",
     "Pipeline",
     "PipelineError",
     "fragility_variables",
     "load_pipeline",
     "parse_pipeline",
+    "rerun_case",
     "run_pipeline",
 ]
 
@@ -131,6 +153,9 @@ logger = logging.getLogger(__name__)
 
 #: Pipeline layout version this module reads.
 SCHEMA_VERSION = 1
+
+#: Default largest number of time-history files of a pipeline's [histories] request.
+DEFAULT_MAX_HISTORIES = 100
 
 #: Defaults of the [fit] table.
 DEFAULT_BOOTSTRAP = 200
@@ -184,6 +209,7 @@ _SCHEMA: dict[str, dict[str, tuple]] = {
         "fit": ((dict,), False),
         "solver": ((dict,), False),
         "execution": ((dict,), False),
+        "histories": ((dict,), False),
     },
     "records": {
         "catalogue": ((str,), False),
@@ -218,6 +244,8 @@ _SCHEMA: dict[str, dict[str, tuple]] = {
     },
     "solver": {"rtol": (_NUM, False), "atol": (_NUM, False), "zeno_omega": (_NUM, False)},
     "execution": {"chunk_size": ((int,), False), "scheduler": ((str,), False)},
+    "histories": {"runs": ((list,), False), "exceeding": ((list,), False),
+                  "max_runs": ((int,), False), "directory": ((str,), False)},
 }
 _REQUIRED_SYSTEM = ("ship_mass", "block_mass", "n_blocks", "half_height", "mu_s_ground",
                     "mu_k_ground", "mu_s_ship", "mu_k_ship")
@@ -301,6 +329,52 @@ def _levels(design: Mapping, prefix: str, measure: str, source: str):
 
 
 @dataclass(frozen=True)
+class HistoryRequest:
+    """The ``[histories]`` table of a pipeline: which runs get full time histories.
+
+    Attributes
+    ----------
+    cases : tuple of int
+        Case numbers picked by the ``runs`` selectors, in the order given.
+    exceeding : tuple of str
+        Limit states whose exceeding runs are added after them.
+    max_runs : int
+        Largest number of histories written.
+    directory : pathlib.Path or None
+        Output folder; None for ``<output stem>_histories/`` beside the output file.
+    """
+
+    cases: tuple[int, ...]
+    exceeding: tuple[str, ...]
+    max_runs: int
+    directory: Path | None
+
+    def select(self, ds: xr.Dataset, design: AnalysisDesign) -> list[int]:
+        """Case numbers to write: the selected ones, then the exceeding ones, capped.
+
+        Parameters
+        ----------
+        ds : xarray.Dataset
+            Summaries with ``exceeded`` and ``valid`` (:func:`fragility_variables`).
+        design : AnalysisDesign
+
+        Returns
+        -------
+        list of int
+        """
+        chosen = dict.fromkeys(self.cases)
+        for name in self.exceeding:
+            hit = (ds["exceeded"].sel(limit_state=name) & ds["valid"].sel(limit_state=name))
+            chosen.update(dict.fromkeys(np.flatnonzero(
+                hit.transpose(*design.dims).values.ravel()).tolist()))
+        cases = list(chosen)
+        if len(cases) > self.max_runs:
+            logger.warning("%d runs selected for time histories; writing the first "
+                           "histories.max_runs = %d", len(cases), self.max_runs)
+        return cases[: self.max_runs]
+
+
+@dataclass(frozen=True)
 class Pipeline:
     """A parsed, validated pipeline file.
 
@@ -333,6 +407,8 @@ class Pipeline:
     scheduler : str or None
     output : pathlib.Path
         Output file (absolute).
+    histories : HistoryRequest or None
+        Runs whose full time histories are written; None for none.
     """
 
     source: str
@@ -350,16 +426,18 @@ class Pipeline:
     chunk_size: int
     scheduler: str | None
     output: Path
+    histories: HistoryRequest | None = None
 
     def identity(self) -> dict:
-        """The parts of the document that determine the results (no output path/scheduler).
+        """The parts of the document that determine the results (no output path, scheduler
+        or history request).
 
         Returns
         -------
         dict
         """
-        doc = {k: v for k, v in self.document.items() if k not in ("output", "title",
-                                                                    "description")}
+        doc = {k: v for k, v in self.document.items()
+               if k not in ("output", "title", "description", "histories")}
         doc["execution"] = {"chunk_size": self.chunk_size}
         doc["records"] = {**doc["records"], "catalogue": str(self.catalogue),
                           "ids": list(self.design.records)}
@@ -424,7 +502,7 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
     version = doc.get("schema_version", SCHEMA_VERSION)
     if version != SCHEMA_VERSION:
         raise PipelineError("schema_version", f"must be {SCHEMA_VERSION}, got {version}", source)
-    for section in ("records", "system", "design", "fit", "solver", "execution"):
+    for section in ("records", "system", "design", "fit", "solver", "execution", "histories"):
         if section in doc:
             _check_table(doc[section], section, source)
 
@@ -580,12 +658,42 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
     chunk_size = ex.get("chunk_size", DEFAULT_CHUNK_SIZE)
     if chunk_size < 1:
         raise PipelineError("execution.chunk_size", "must be >= 1", source)
+    histories = None
+    if "histories" in doc:
+        histories = _parse_histories(doc["histories"], design, limit_states, base, source)
     return Pipeline(
         source=source, text=text, document=doc, catalogue=catalogue, azimuth=azimuth,
         horizontal=horizontal, response=response, chain=chain, design=design,
         limit_states=limit_states, fit=fit, solver=solver, chunk_size=int(chunk_size),
         scheduler=ex.get("scheduler"), output=(base / doc["output"]).resolve(),
+        histories=histories,
     )
+
+
+def _parse_histories(table, design, limit_states, base, source) -> HistoryRequest:
+    cases: list[int] = []
+    for i, selector in enumerate(table.get("runs", [])):
+        if not isinstance(selector, dict):
+            raise PipelineError(f"histories.runs[{i}]", "must be a table such as "
+                                "{record = 'NP.1765', im_level_g = 0.8}", source)
+        try:
+            cases.extend(select_cases(design, selector).tolist())
+        except SelectionError as exc:
+            raise PipelineError(f"histories.runs[{i}].{exc.key}", exc.problem, source) from None
+    names = [ls.name for ls in limit_states]
+    exceeding = table.get("exceeding", [])
+    for name in exceeding:
+        if name not in names:
+            raise PipelineError("histories.exceeding", f"no limit state named {name!r}; "
+                                f"limit states: {', '.join(names)}", source)
+    if not cases and not exceeding:
+        raise PipelineError("histories", "select runs with 'runs' and/or 'exceeding'", source)
+    max_runs = table.get("max_runs", DEFAULT_MAX_HISTORIES)
+    if max_runs < 1:
+        raise PipelineError("histories.max_runs", "must be >= 1", source)
+    directory = (base / table["directory"]).resolve() if "directory" in table else None
+    return HistoryRequest(tuple(dict.fromkeys(cases)), tuple(exceeding), int(max_runs),
+                          directory)
 
 
 def _check_chain(chain, source):
@@ -839,12 +947,15 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         read, processed and scaled, partial-results directory opened),
         ``runs`` (all chunks, with ``solver`` the part spent in
         :func:`~shipblock.fragility.batch.run_chunk` when run locally), ``fragility``
-        (dataset, limit states, fits), ``write`` (NetCDF written and read back).
+        (dataset, limit states, fits), ``histories`` (time histories, if requested),
+        ``write`` (NetCDF written and read back).
 
     Returns
     -------
     xarray.Dataset
-        The results, as read back from the output file.
+        The results, as read back from the output file. With a ``[histories]`` request, the
+        runs' time-history files are written first (resuming like the runs) and listed in the
+        variable ``history_file``.
 
     Raises
     ------
@@ -918,9 +1029,107 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     if intensity.period is not None:
         ds.attrs["im_period"] = intensity.period
     clock.lap("fragility")
+    if pipe.histories is not None:
+        ds = _add_histories(ds, pipe, records, out_path, fingerprint, progress)
+        clock.lap("histories")
     write_dataset(ds, out_path)
     store.remove()
     logger.info("wrote %s", out_path)
     ds = open_results(out_path)
     clock.lap("write")
     return ds
+
+
+# --------------------------------------------------------------------------------------------
+# time histories
+# --------------------------------------------------------------------------------------------
+
+
+def _add_histories(ds, pipe: Pipeline, records, out_path: Path, fingerprint: str,
+                   progress: bool) -> xr.Dataset:
+    """Write the requested time histories and list them in ``ds["history_file"]``."""
+    import os
+
+    design = pipe.design
+    request = pipe.histories
+    directory = request.directory or out_path.with_name(out_path.stem + "_histories")
+    cases = request.select(ds, design)
+    attrs = {"pipeline": pipe.text, "pipeline_source": str(pipe.source),
+             "solver_options": json.dumps(pipe.solver, sort_keys=True)}
+    written = write_histories(design, records, cases, directory, pipe.solver, fingerprint,
+                              attrs, progress)
+    files = np.full(design.n_cases, "", dtype=object)
+    for case, path in written.items():
+        files[case] = Path(os.path.relpath(path, out_path.parent)).as_posix()
+    shape = design.shape if design.intensity.scaled else (design.shape[0], *design.shape[2:])
+    ds["history_file"] = xr.DataArray(
+        files.reshape(shape), dims=design.dims,
+        attrs={"units": "1", "long_name": "NetCDF file of the run's full time histories, "
+                                          "relative to this file's folder (empty: none)"})
+    ds.attrs["histories_directory"] = Path(os.path.relpath(directory, out_path.parent)).as_posix()
+    logger.info("%d time histories in %s", len(written), directory)
+    return ds
+
+
+def rerun_case(path, record: str, *, im_level=None, im_level_g=None, **sweep):
+    """Simulate one run of a pipeline again, with its full time histories.
+
+    The record is read and processed as the pipeline does it and the run gets the same input,
+    system and solver options as in the batch, so its summary equals the batch's bit for bit.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The pipeline file.
+    record : str
+        Record id (or its last part, e.g. ``"NP.1765"``).
+    im_level, im_level_g : float, optional
+        The IM level [SI units of the measure] or [g] (PGA, Sa); required if the design has
+        several levels.
+    **sweep
+        Values of the swept parameters (each required if it has several values).
+
+    Returns
+    -------
+    shipblock.SimulationResult
+
+    Raises
+    ------
+    PipelineError
+        If the pipeline is invalid or the selection names no single run (names the key).
+    ShipblockError
+        If the record cannot be read, processed or scaled.
+
+    Examples
+    --------
+    >>> res = rerun_case("pipelines/demo.toml", "NP.1765", im_level_g=0.8)  # doctest: +SKIP
+    >>> res.summary["peak_ship_slip"]  # doctest: +SKIP
+    """
+    return _rerun(path, record, im_level=im_level, im_level_g=im_level_g, **sweep)[1]
+
+
+def _rerun(path, record, im_level=None, im_level_g=None, **sweep):
+    """Run one case of a pipeline; returns ``(dataset of the run, result)``."""
+    from shipblock.catalogue import load_catalogue
+
+    pipe = load_pipeline(path)
+    design = pipe.design
+    selector = {"record": record, **sweep}
+    if im_level is not None:
+        selector["im_level"] = im_level
+    if im_level_g is not None:
+        selector["im_level_g"] = im_level_g
+    try:
+        case = case_number(design, selector)
+    except SelectionError as exc:
+        raise PipelineError(exc.key, exc.problem, pipe.source) from None
+    r = int(design.case_indices([case])[0, 0])
+    rid = design.records[r]
+    records = [None] * len(design.records)
+    records[r] = prepare_record(rid, _loader(load_catalogue(pipe.catalogue)[rid], pipe),
+                                pipe.chain, design.intensity)
+    result = run_case(design, records, case, pipe.solver)
+    ds = case_dataset(result, design, records, case,
+                      {"pipeline": pipe.text, "pipeline_source": str(pipe.source),
+                       "solver_options": json.dumps(pipe.solver, sort_keys=True)})
+    return ds, result
