@@ -192,3 +192,17 @@ def test_history_command_prints_writes_and_draws(history_run, tmp_path, capsys):
 
 def test_top_level_export():
     assert shipblock.rerun_case is rerun_case
+
+
+def test_selectors_skip_runs_outside_a_stripe(tmp_path):
+    levels = 'levels_g = [0.3, 0.6]\nstripes = [["S0", "S1"], ["S1", "S2"]]'
+    path = write_pipeline(tmp_path, kind="msa", levels=levels)
+    design = load_pipeline(path).design
+    assert [hist_module.history_filename(design, c)
+            for c in select_cases(design, {"record": "S1"})] == ["S1_im0.nc", "S1_im1.nc"]
+    assert [hist_module.history_filename(design, c)
+            for c in select_cases(design, {"record": "S2"})] == ["S2_im1.nc"]
+    with pytest.raises(SelectionError, match="not in the stripe"):
+        case_number(design, {"record": "S2", "im_level_g": 0.3})
+    with pytest.raises(SelectionError, match="in no stripe"):
+        select_cases(design, {"record": "S0", "im_level_g": 0.6})

@@ -195,6 +195,55 @@ def test_sweep_msa_and_error_record(tmp_path):
     assert set(ds["fit_method"].sel(limit_state="ship_slip").values.ravel()) <= {"mle", ""}
 
 
+def test_msa_with_a_record_set_per_stripe(tmp_path):
+    # levels where the synthetic records' ship slip crosses the 5 mm threshold
+    levels = "levels_g = [0.3, 0.4, 0.45, 0.475, 0.5, 0.6]"
+    stripes = ('stripes = [["S0", "S1"], ["syn/S1", "S2"], ["S0", "S1"], ["S0", "S2"], ["S1"], '
+               '["S2"]]')
+    path = write_pipeline(tmp_path, kind="msa", levels=levels + "\n" + stripes)
+    ds = run_pipeline(path, progress=False)
+    full = run_pipeline(write_pipeline(tmp_path, kind="msa", levels=levels, name="full.toml"),
+                        output=tmp_path / "full.nc", progress=False)
+    mask = np.array([[1, 0, 1, 1, 0, 0], [1, 1, 1, 0, 1, 0], [0, 1, 0, 1, 0, 1]], dtype=bool)
+    np.testing.assert_array_equal(ds["in_stripe"], mask)
+    assert ds["in_stripe"].dims == ("record", "im_level")
+    # runs in a stripe are the full design's runs bit for bit; the others are not made
+    for name in ("peak_ship_slip", "residual_ship_slip", "n_events"):
+        np.testing.assert_array_equal(ds[name].values[mask], full[name].values[mask])
+        assert np.isnan(ds[name].values[~mask]).all()
+    valid = ds["valid"].sel(limit_state="ship_slip").values
+    np.testing.assert_array_equal(valid, mask)
+    # the fit counts only the runs of each stripe
+    from shipblock.fragility.fit import fit_msa
+
+    exceeded = ds["exceeded"].sel(limit_state="ship_slip").values
+    fit = fit_msa(exceeded, ds["im_level"].values, valid)
+    assert float(ds["median"].sel(limit_state="ship_slip")) == pytest.approx(fit.median,
+                                                                            rel=1e-12)
+    # which is not the fit of the full grid
+    assert float(ds["median"].sel(limit_state="ship_slip")) != float(
+        full["median"].sel(limit_state="ship_slip"))
+
+
+@pytest.mark.parametrize(
+    ("stripes", "kind", "key", "needle"),
+    [
+        ('[["S0"], ["S1"]]', "msa", "design.stripes", "one record list per level"),
+        ('[["S0"], ["S1"], ["nope"]]', "msa", "design.stripes[2]", "not one of the records"),
+        ('[["S0"], ["S1"], ["S1"]]', "msa", "design.stripes", "in no stripe: syn/S2"),
+        ('[["S0"], [], ["S1", "S2"]]', "msa", "design.stripes", "stripe 1 has no records"),
+        ('[["S0", "S1", "S2"]] ', "ida", "design.stripes", "only to type 'msa'"),
+        ('["S0", "S1", "S2"]', "msa", "design.stripes[0]", "list of record ids"),
+    ],
+)
+def test_invalid_stripes_name_the_key(tmp_path, stripes, kind, key, needle):
+    levels = "levels_g = [0.2, 0.5, 0.8]" if kind == "msa" else "levels_g = [0.2]"
+    path = write_pipeline(tmp_path, kind=kind, levels=f"{levels}\nstripes = {stripes}")
+    with pytest.raises(PipelineError, match=needle) as info:
+        load_pipeline(path)
+    assert info.value.key == key
+
+
 def test_cloud_design(tmp_path):
     path = write_pipeline(tmp_path, kind="cloud", levels="", n_records=3)
     ds = run_pipeline(path, progress=False)

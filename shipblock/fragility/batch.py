@@ -263,11 +263,12 @@ _NAMES = tuple(RUN_VARIABLES)
 class _Task:
     """What one chunk needs: its cases, the runnable ones and their local indices."""
 
-    def __init__(self, design: AnalysisDesign, chunk: range, ok_records: np.ndarray):
+    def __init__(self, design: AnalysisDesign, chunk: range, ok_records: np.ndarray,
+                 in_stripe: np.ndarray):
         self.chunk = chunk
         self.cases = np.arange(chunk.start, chunk.stop, dtype=np.int64)
         idx = design.case_indices(self.cases)
-        self.runnable = ok_records[idx[:, 0]]
+        self.runnable = ok_records[idx[:, 0]] & in_stripe[idx[:, 0], idx[:, 1]]
         idx = idx[self.runnable]
         self.records, local = np.unique(idx[:, 0], return_inverse=True)
         self.local_cases = np.column_stack([local.ravel(), idx[:, 1], idx[:, 2]])
@@ -374,7 +375,8 @@ def run_batch(
     bar = tqdm(total=n, initial=done_cases, unit="run", desc="shipblock", disable=not progress,
                smoothing=0.1)
     try:
-        tasks = {k: _Task(design, chunks[k], ok) for k in pending}
+        in_stripe = design.stripe_mask()
+        tasks = {k: _Task(design, chunks[k], ok, in_stripe) for k in pending}
 
         def finish(k: int, out):
             task = tasks.pop(k)
@@ -449,7 +451,8 @@ def summary_dataset(design: AnalysisDesign, records: list[PreparedRecord],
     xarray.Dataset
         Per-run variables of :data:`~shipblock.fragility.store.RUN_VARIABLES` and
         ``run_error`` on ``design.dims``; per record and level ``scale_factor``,
-        ``vertical_scale_factor``, ``achieved_im``, ``achieved_im_vertical``; per record
+        ``vertical_scale_factor``, ``achieved_im``, ``achieved_im_vertical`` (and
+        ``in_stripe`` for a design with per-level record sets); per record
         ``record_error``, ``record_dt``, ``record_npts``, ``record_im``. All with ``units`` and
         ``long_name``.
     """
@@ -490,6 +493,10 @@ def summary_dataset(design: AnalysisDesign, records: list[PreparedRecord],
         lvl_dims, per_level("achieved_v"),
         {"units": im_units, "long_name": f"{intensity.measure.upper()} of the scaled vertical"},
     )
+    if design.stripes is not None:
+        data["in_stripe"] = (lvl_dims, design.stripe_mask(),
+                             {"units": "1", "long_name": "record belongs to the stripe of the "
+                                                         "level (runs outside are not made)"})
     data["record_error"] = (
         ("record",), np.array([r.error or "" for r in records], dtype=object),
         {"units": "1", "long_name": "why the record was left out (empty if used)"},

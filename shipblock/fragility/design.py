@@ -307,12 +307,19 @@ class AnalysisDesign:
         The base system.
     sweep : tuple of (str, tuple)
         ``(parameter, values)`` pairs, one dimension each, in order.
+    stripes : tuple of tuple of str, optional
+        Multiple-stripe analysis only: the records run at each IM level (one tuple per level,
+        each a subset of ``records``), as when every stripe has its own record selection
+        (e.g. matched to a conditional spectrum). Runs of a record outside a level's stripe
+        are not made; their results are NaN and they count as invalid in every limit state.
+        None (default): every record at every level.
     """
 
     records: tuple[str, ...]
     intensity: IntensityDesign
     system: ShipBlockSystem
     sweep: tuple[tuple[str, tuple], ...] = field(default_factory=tuple)
+    stripes: tuple[tuple[str, ...], ...] | None = None
 
     def validate(self) -> AnalysisDesign:
         """Check the grid and build every swept system once.
@@ -346,8 +353,57 @@ class AnalysisDesign:
                 raise ValueError(f"sweep {name!r} has no values")
             if len(set(values)) != len(values):
                 raise ValueError(f"sweep {name!r} repeats a value")
+        if self.stripes is not None:
+            self._validate_stripes()
         self.systems()
         return self
+
+    def _validate_stripes(self) -> None:
+        if self.intensity.kind != "msa":
+            raise ValueError("stripes (a record set per level) apply only to type 'msa'")
+        if len(self.stripes) != self.intensity.n_levels:
+            raise ValueError(f"stripes must give one record list per level "
+                             f"({self.intensity.n_levels}), got {len(self.stripes)}")
+        for j, stripe in enumerate(self.stripes):
+            if not stripe:
+                raise ValueError(f"stripe {j} has no records")
+            unknown = [r for r in stripe if r not in self.records]
+            if unknown:
+                raise ValueError(f"stripe {j}: {', '.join(map(repr, unknown))} not among the "
+                                 "design's records")
+            if len(set(stripe)) != len(stripe):
+                raise ValueError(f"stripe {j} repeats a record")
+        unused = [r for r in self.records if not any(r in s for s in self.stripes)]
+        if unused:
+            raise ValueError(f"records in no stripe: {', '.join(unused)}")
+
+    def stripe_mask(self) -> np.ndarray:
+        """Which (record, level) pairs are run.
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (n_records, n_levels)
+            All True unless :attr:`stripes` is given.
+        """
+        mask = np.ones(self.shape[:2], dtype=bool)
+        if self.stripes is not None:
+            for j, stripe in enumerate(self.stripes):
+                mask[:, j] = [r in stripe for r in self.records]
+        return mask
+
+    def in_design(self, cases) -> np.ndarray:
+        """Whether each case is run (False for a record outside its level's stripe).
+
+        Parameters
+        ----------
+        cases : array_like of int
+
+        Returns
+        -------
+        numpy.ndarray of bool
+        """
+        idx = self.case_indices(cases)
+        return self.stripe_mask()[idx[:, 0], idx[:, 1]]
 
     # -- grid --------------------------------------------------------------------------------
     @property

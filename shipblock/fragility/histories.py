@@ -139,7 +139,8 @@ def select_cases(design: AnalysisDesign, selector: Mapping) -> np.ndarray:
     Returns
     -------
     numpy.ndarray of int
-        Case numbers, increasing.
+        Case numbers, increasing (only runs of the design: with per-level record sets, not
+        those of a record outside a level's stripe).
 
     Raises
     ------
@@ -148,8 +149,12 @@ def select_cases(design: AnalysisDesign, selector: Mapping) -> np.ndarray:
     """
     picks = _selected_indices(design, selector)
     grid = np.meshgrid(*[np.asarray(p, dtype=np.int64) for p in picks], indexing="ij")
-    cases = np.ravel_multi_index([g.ravel() for g in grid], design.shape)
-    return np.sort(cases.astype(np.int64))
+    cases = np.ravel_multi_index([g.ravel() for g in grid], design.shape).astype(np.int64)
+    cases = cases[design.in_design(cases)]
+    if cases.size == 0:
+        raise SelectionError("record", f"{selector['record']!r} is in no stripe of the "
+                                       "selected levels")
+    return np.sort(cases)
 
 
 def case_number(design: AnalysisDesign, selector: Mapping) -> int:
@@ -176,7 +181,11 @@ def case_number(design: AnalysisDesign, selector: Mapping) -> int:
     if vague:
         raise SelectionError(vague[0], f"the selector matches several runs; also give "
                                        f"{' and '.join(vague)}")
-    return int(np.ravel_multi_index([p[0] for p in picks], design.shape))
+    case = int(np.ravel_multi_index([p[0] for p in picks], design.shape))
+    if not design.in_design([case])[0]:
+        raise SelectionError("record", f"{selector['record']!r} is not in the stripe of that "
+                                       "level (the run was not made)")
+    return case
 
 
 def case_coordinates(design: AnalysisDesign, case: int) -> dict:

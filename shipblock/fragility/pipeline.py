@@ -38,6 +38,8 @@ Schema (``schema_version = 1``; units in brackets, paths relative to the pipelin
     levels_g = [0.1, 0.2, 0.4]          # or levels = [...] with units = "m/s^2" ("m/s" for PGV)
     vertical = "same"                   # "same", "independent" (+ vertical_levels[_g]),
                                         # "unscaled" or "zero"
+    stripes = [["NP.1737", "NP.1743"], ["NP.1759", "NP.1765"], ...]
+                                        # msa only, optional: the records of each level
     cloud_method = "probit"             # cloud only: "probit" or "regression"
 
     [[limit_states]]                    # see shipblock.fragility.limit_states
@@ -235,6 +237,7 @@ _SCHEMA: dict[str, dict[str, tuple]] = {
         "vertical_levels": ((list,), False),
         "vertical_levels_g": ((list,), False),
         "cloud_method": ((str,), False),
+        "stripes": ((list,), False),
     },
     "fit": {
         "bootstrap": ((int,), False),
@@ -287,6 +290,23 @@ def _numbers(values, key: str, source: str) -> tuple[float, ...]:
         if isinstance(v, bool) or not isinstance(v, _NUM) or not math.isfinite(v):
             raise PipelineError(key, f"must hold finite numbers only, got {v!r}", source)
     return tuple(float(v) for v in values)
+
+
+def _stripes(value, ids, source) -> tuple[tuple[str, ...], ...]:
+    """Per-level record lists, ids given in full or by their last part."""
+    out = []
+    for j, stripe in enumerate(value):
+        if not isinstance(stripe, list) or not all(isinstance(r, str) for r in stripe):
+            raise PipelineError(f"design.stripes[{j}]", "must be a list of record ids", source)
+        full = []
+        for r in stripe:
+            match = [i for i in ids if i == r] or [i for i in ids if i.split("/")[-1] == r]
+            if len(match) != 1:
+                raise PipelineError(f"design.stripes[{j}]", f"{r!r} is not one of the records "
+                                    f"(records.ids): {', '.join(ids)}", source)
+            full.append(match[0])
+        out.append(tuple(full))
+    return tuple(out)
 
 
 def _im_factor(measure: str, units: str, key: str, source: str) -> float:
@@ -608,7 +628,14 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
         raise PipelineError("design.cloud_method", "must be 'probit' or 'regression'", source)
     if "cloud_method" in d and kind != "cloud":
         raise PipelineError("design.cloud_method", "applies only to type = 'cloud'", source)
-    design = AnalysisDesign(tuple(ids), intensity, system, tuple(sweep))
+    stripes = None
+    if "stripes" in d:
+        stripes = _stripes(d["stripes"], ids, source)
+        try:
+            AnalysisDesign(tuple(ids), intensity, system, (), stripes)._validate_stripes()
+        except ValueError as exc:
+            raise PipelineError("design.stripes", str(exc), source) from None
+    design = AnalysisDesign(tuple(ids), intensity, system, tuple(sweep), stripes)
     try:
         design.validate()
     except ValueError as exc:
