@@ -32,6 +32,24 @@ ACCELERATION_UNITS_TO_SI: dict[str, float] = {
 }
 
 
+#: Factors that convert a velocity in the named unit to m/s (e.g. PGV levels).
+VELOCITY_UNITS_TO_SI: dict[str, float] = {
+    "m/s": 1.0,
+    "cm/s": 0.01,
+    "mm/s": 0.001,
+    "in/s": INCH,
+}
+
+
+def _to_si(values, unit: str, table: dict[str, float], quantity: str):
+    try:
+        factor = table[unit.strip().lower()]
+    except KeyError:
+        known = ", ".join(sorted(table))
+        raise ValueError(f"unknown {quantity} unit {unit!r}; known units: {known}") from None
+    return np.asarray(values, dtype=float) * factor
+
+
 def acceleration_to_si(values, unit: str):
     """Convert accelerations from ``unit`` to m/s^2.
 
@@ -53,9 +71,28 @@ def acceleration_to_si(values, unit: str):
     ValueError
         If the unit is not known.
     """
-    try:
-        factor = ACCELERATION_UNITS_TO_SI[unit.strip().lower()]
-    except KeyError:
-        known = ", ".join(sorted(ACCELERATION_UNITS_TO_SI))
-        raise ValueError(f"unknown acceleration unit {unit!r}; known units: {known}") from None
-    return np.asarray(values, dtype=float) * factor
+    return _to_si(values, unit, ACCELERATION_UNITS_TO_SI, "acceleration")
+
+
+def velocity_to_si(values, unit: str):
+    """Convert velocities from ``unit`` to m/s.
+
+    Parameters
+    ----------
+    values : array_like
+        Velocities in ``unit``.
+    unit : str
+        One of the keys of :data:`VELOCITY_UNITS_TO_SI` (case-insensitive): ``"m/s"``,
+        ``"cm/s"``, ``"mm/s"`` or ``"in/s"``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Velocities [m/s].
+
+    Raises
+    ------
+    ValueError
+        If the unit is not known.
+    """
+    return _to_si(values, unit, VELOCITY_UNITS_TO_SI, "velocity")

@@ -244,6 +244,27 @@ def test_invalid_stripes_name_the_key(tmp_path, stripes, kind, key, needle):
     assert info.value.key == key
 
 
+@pytest.mark.parametrize(
+    ("levels", "expected", "error"),
+    [
+        ('levels = [10.0, 20.0]\nunits = "cm/s"', [0.1, 0.2], None),
+        ('levels = [0.1, 0.2]\nunits = "M/S"', [0.1, 0.2], None),
+        ('levels = [4.0, 8.0]\nunits = "in/s"', [0.1016, 0.2032], None),
+        ('levels = [10.0, 20.0]\nunits = "cm/s^2"', None, "unknown velocity unit"),
+        ("levels_g = [0.1, 0.2]", None, "PGV levels are velocities"),
+    ],
+)
+def test_pgv_levels_are_velocities_in_si(tmp_path, levels, expected, error):
+    path = write_pipeline(tmp_path, levels='measure = "pgv"\n' + levels)
+    if error:
+        with pytest.raises(PipelineError, match=error):
+            load_pipeline(path)
+        return
+    design = load_pipeline(path).design
+    np.testing.assert_allclose(design.intensity.levels, expected, rtol=1e-15)
+    assert design.intensity.units == "m/s"
+
+
 def test_cloud_design(tmp_path):
     path = write_pipeline(tmp_path, kind="cloud", levels="", n_records=3)
     ds = run_pipeline(path, progress=False)

@@ -76,8 +76,8 @@ the result's ``history_file`` variable.
 
 IM levels are converted to SI once, here: ``levels_g`` multiplies by
 :data:`shipblock.units.STANDARD_GRAVITY`; ``levels`` with ``units`` goes through
-:func:`shipblock.units.acceleration_to_si` (a velocity unit ``"X/s"`` for PGV uses the length
-factor of ``"X/s^2"``). The dataset stores the levels, medians and achieved IMs in SI.
+:func:`shipblock.units.acceleration_to_si` (:func:`shipblock.units.velocity_to_si` for PGV).
+The dataset stores the levels, medians and achieved IMs in SI.
 """
 
 from __future__ import annotations
@@ -137,7 +137,7 @@ from shipblock.fragility.limit_states import (
 from shipblock.fragility.store import ChunkStore, StoreError, open_results, write_dataset
 from shipblock.solver import DEFAULT_ATOL, DEFAULT_RTOL, DEFAULT_ZENO_OMEGA
 from shipblock.system import ShipBlockSystem
-from shipblock.units import ACCELERATION_UNITS_TO_SI, STANDARD_GRAVITY, acceleration_to_si
+from shipblock.units import STANDARD_GRAVITY, acceleration_to_si, velocity_to_si
 
 __all__ = [
     "SCHEMA_VERSION",
@@ -311,17 +311,11 @@ def _stripes(value, ids, source) -> tuple[tuple[str, ...], ...]:
 
 def _im_factor(measure: str, units: str, key: str, source: str) -> float:
     """SI factor of a unit given for the IM ``measure``."""
-    u = units.strip().lower()
-    if measure == "pgv":
-        if not u.endswith("/s") or f"{u}^2" not in ACCELERATION_UNITS_TO_SI:
-            known = sorted(k[:-2] for k in ACCELERATION_UNITS_TO_SI if k.endswith("/s^2"))
-            raise PipelineError(key, f"unknown velocity unit {units!r} for PGV; use one of "
-                                     f"{', '.join(known)}", source)
-        return ACCELERATION_UNITS_TO_SI[f"{u}^2"]
+    convert = velocity_to_si if measure == "pgv" else acceleration_to_si
     try:
-        return float(acceleration_to_si(1.0, u))
+        return float(convert(1.0, units))
     except ValueError as exc:
-        raise PipelineError(key, str(exc), source) from None
+        raise PipelineError(key, f"{exc} (for {measure.upper()})", source) from None
 
 
 def _levels(design: Mapping, prefix: str, measure: str, source: str):
