@@ -1,17 +1,22 @@
 """Error types of shipblock.
 
 Every error that shipblock raises on purpose derives from :class:`ShipblockError`, so callers can
-catch the project's own failures with one ``except`` clause. Record errors also derive from
-:class:`ValueError`, the type that Python code conventionally raises for bad input data.
+catch the project's own failures with one ``except`` clause. Errors in parameters and records
+also derive from :class:`ValueError`, the type that Python code conventionally raises for bad
+input data.
 """
 
 from __future__ import annotations
 
-__all__ = ["RecordError", "ShipblockError", "UnitsError"]
+__all__ = ["ParameterError", "RecordError", "ShipblockError", "UnitsError"]
 
 
 class ShipblockError(Exception):
     """Base class of every error raised on purpose by shipblock."""
+
+
+class ParameterError(ShipblockError, ValueError):
+    """A parameter, option or input array is invalid; the message names it and its value."""
 
 
 class RecordError(ShipblockError, ValueError):

@@ -53,7 +53,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from shipblock.errors import RecordError
+from shipblock.errors import ParameterError, RecordError
 from shipblock.units import STANDARD_GRAVITY
 
 __all__ = [
@@ -158,7 +158,7 @@ def _check_dt(dt) -> float:
 def _check_damping(damping) -> float:
     damping = float(damping)
     if not (0.0 <= damping < 1.0):
-        raise ValueError(
+        raise ParameterError(
             f"damping must be a fraction of critical in [0, 1) (under-damped oscillator), "
             f"got {damping}"
         )
@@ -379,7 +379,7 @@ def significant_duration(acc, dt, start=0.05, end=0.95) -> float:
        earthquake ground motion. *Bull. Seismol. Soc. Am.* 65(3), 581-626.
     """
     if not (0.0 <= start < end <= 1.0):
-        raise ValueError(f"need 0 <= start < end <= 1, got start={start}, end={end}")
+        raise ParameterError(f"need 0 <= start < end <= 1, got start={start}, end={end}")
     h = husid(acc, dt)
     t = np.arange(h.size) * _check_dt(dt)
     return float(_crossing_time(h, t, end) - _crossing_time(h, t, start))
@@ -462,7 +462,7 @@ def cav5(acc, dt, threshold=CAV5_THRESHOLD) -> float:
     a = _as_record(acc)
     threshold = float(threshold)
     if not np.isfinite(threshold) or threshold < 0.0:
-        raise ValueError(f"threshold must be a non-negative acceleration [m/s^2], got {threshold}")
+        raise ParameterError(f"threshold must be a non-negative acceleration [m/s^2], got {threshold}")
     absa = np.abs(a)
     return float(np.trapezoid(np.where(absa >= threshold, absa, 0.0), dx=_check_dt(dt)))
 
@@ -565,7 +565,7 @@ def sdof_response(acc, dt, period, damping=DEFAULT_DAMPING):
     zeta = _check_damping(damping)
     period = float(period)
     if not np.isfinite(period) or period <= 0.0:
-        raise ValueError(f"period must be positive and finite [s], got {period}")
+        raise ParameterError(f"period must be positive and finite [s], got {period}")
     omega = np.array([2.0 * np.pi / period])
     coef = [float(x[0]) for x in _nigam_jennings_coefficients(omega, zeta, dt)]
     a, b, c, d, ap, bp, cp, dp = coef
@@ -628,9 +628,9 @@ def response_spectrum(acc, dt, periods, damping=DEFAULT_DAMPING) -> ResponseSpec
     zeta = _check_damping(damping)
     periods = np.atleast_1d(np.asarray(periods, dtype=np.float64))
     if periods.ndim != 1:
-        raise ValueError(f"periods must be a scalar or 1-D array, got shape {periods.shape}")
+        raise ParameterError(f"periods must be a scalar or 1-D array, got shape {periods.shape}")
     if not np.all(np.isfinite(periods)) or np.any(periods < 0.0):
-        raise ValueError("periods must be finite and >= 0 [s]")
+        raise ParameterError("periods must be finite and >= 0 [s]")
     sd = np.zeros_like(periods)
     omega = np.full_like(periods, np.inf)
     pos = periods > 0.0
@@ -743,7 +743,7 @@ def intensity_measures_hv(
     h = _as_record(horizontal)
     v = _as_record(vertical)
     if h.shape != v.shape:
-        raise ValueError(
+        raise ParameterError(
             f"horizontal and vertical must have the same length, got {h.size} and {v.size}"
         )
     im_h = intensity_measures(h, dt, periods, damping)

@@ -34,7 +34,7 @@ import numpy as np
 import obspy
 from obspy import Stream, Trace, UTCDateTime
 
-from shipblock.errors import RecordError, ShipblockError, UnitsError
+from shipblock.errors import ParameterError, RecordError, ShipblockError, UnitsError
 from shipblock.io import read_record
 from shipblock.io._common import si_factor
 
@@ -116,10 +116,10 @@ def rotate_to_azimuth(h1, h2, azimuth_h1: float, azimuth_h2: float, azimuth: flo
         azimuth is not finite.
     """
     if not all(math.isfinite(float(a)) for a in (azimuth_h1, azimuth_h2, azimuth)):
-        raise ValueError("azimuths must be finite numbers [deg]")
+        raise ParameterError("azimuths must be finite numbers [deg]")
     separation = (azimuth_h2 - azimuth_h1) % 360.0
     if min(abs(separation - 90.0), abs(separation - 270.0)) > ORIENTATION_TOLERANCE:
-        raise ValueError(
+        raise ParameterError(
             f"horizontals at {azimuth_h1:g} and {azimuth_h2:g} deg are not orthogonal"
         )
     h1 = np.asarray(h1, dtype=float)
@@ -237,7 +237,7 @@ def _merge_gaps(stream: Stream, gaps: str) -> Stream:
             elif gaps == "interpolate":
                 joined = group.copy().merge(method=1, fill_value="interpolate")
             else:
-                raise ValueError(f"gaps must be 'refuse' or 'interpolate', not {gaps!r}")
+                raise ParameterError(f"gaps must be 'refuse' or 'interpolate', not {gaps!r}")
         except ValueError:
             raise
         except Exception as exc:  # noqa: BLE001
@@ -328,7 +328,7 @@ def _to_si(trace: Trace, inventory, inventory_name, units, response) -> str:
                     trace.remove_response(inventory=inventory, output="ACC")
                     how = f"counts -> m/s**2 by the full response of {inventory_name}"
                 else:
-                    raise ValueError(f"response must be 'sensitivity' or 'full', not {response!r}")
+                    raise ParameterError(f"response must be 'sensitivity' or 'full', not {response!r}")
             except (ShipblockError, ValueError) as exc:
                 if isinstance(exc, ShipblockError) or "response must be" in str(exc):
                     raise
@@ -452,7 +452,7 @@ def _assign_components(
                 notes.append(f"{trace.id} not in the component mapping; left out")
                 continue
             if component not in COMPONENTS:
-                raise ValueError(f"channel_map values must be one of {COMPONENTS}: {component!r}")
+                raise ParameterError(f"channel_map values must be one of {COMPONENTS}: {component!r}")
             if component in assigned:
                 raise RecordError(label, f"two channels are mapped to {component}")
             assigned[component] = trace
@@ -667,9 +667,9 @@ class GroundMotion:
     def __init__(self, stream: Stream, metadata: dict | None = None, azimuth=None,
                  horizontal=None):
         if azimuth is not None and horizontal is not None:
-            raise ValueError("give azimuth= or horizontal=, not both")
+            raise ParameterError("give azimuth= or horizontal=, not both")
         if horizontal is not None and horizontal not in ("H1", "H2"):
-            raise ValueError(f"horizontal must be 'H1' or 'H2', not {horizontal!r}")
+            raise ParameterError(f"horizontal must be 'H1' or 'H2', not {horizontal!r}")
         self._metadata = dict(metadata or {})
         label = ", ".join(self._metadata.get("source_files", [])) or "<stream>"
         self._traces = _validate(stream, label)
@@ -942,9 +942,9 @@ def read_motion(
         If the units of a trace are unknown or contradictory.
     """
     if azimuth is not None and horizontal is not None:
-        raise ValueError("give azimuth= or horizontal=, not both")
+        raise ParameterError("give azimuth= or horizontal=, not both")
     if align not in ("trim", "strict"):
-        raise ValueError(f"align must be 'trim' or 'strict', not {align!r}")
+        raise ParameterError(f"align must be 'trim' or 'strict', not {align!r}")
     stream = _load_stream(paths_or_stream, units, format, read_kwargs)
     label = ", ".join(dict.fromkeys(_source(tr) for tr in stream)) or "<stream>"
     if len(stream) == 0:

@@ -40,7 +40,7 @@ from types import MappingProxyType
 import numpy as np
 from obspy import Stream, Trace
 
-from shipblock.errors import ShipblockError
+from shipblock.errors import ParameterError, ShipblockError
 from shipblock.intensity import displacement
 
 __all__ = [
@@ -179,7 +179,7 @@ def step(name: str):
 
     def register(impl):
         if name in STEPS:
-            raise ValueError(f"processing step {name!r} is registered twice")
+            raise ParameterError(f"processing step {name!r} is registered twice")
         signature = inspect.signature(impl)
 
         @functools.wraps(impl)

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from shipblock import intensity
-from shipblock.errors import RecordError
+from shipblock.errors import ParameterError, RecordError
 
 __all__ = [
     "MEASURES",
@@ -102,35 +102,35 @@ def _check_record(acc, label: str) -> np.ndarray:
 
 def _check_measure(measure: str, period, damping):
     if measure not in MEASURES:
-        raise ValueError(f"unknown scaling measure {measure!r}; known: {', '.join(MEASURES)}")
+        raise ParameterError(f"unknown scaling measure {measure!r}; known: {', '.join(MEASURES)}")
     if measure == "sa":
         if period is None:
-            raise ValueError("measure 'sa' needs a period [s]")
+            raise ParameterError("measure 'sa' needs a period [s]")
         period = float(period)
         if not np.isfinite(period) or period <= 0.0:
-            raise ValueError(
+            raise ParameterError(
                 f"period must be > 0 [s] for measure 'sa', got {period} (use measure 'pga' "
                 "for the zero-period limit)"
             )
         damping = float(damping)
         if not (0.0 <= damping < 1.0):
-            raise ValueError(f"damping must be in [0, 1), got {damping}")
+            raise ParameterError(f"damping must be in [0, 1), got {damping}")
     elif period is not None:
-        raise ValueError(f"period applies only to measure 'sa', not {measure!r}")
+        raise ParameterError(f"period applies only to measure 'sa', not {measure!r}")
     return period, damping
 
 
 def _check_target(target, label="target") -> float:
     target = float(target)
     if not np.isfinite(target) or target <= 0.0:
-        raise ValueError(f"{label} must be a positive finite value, got {target}")
+        raise ParameterError(f"{label} must be a positive finite value, got {target}")
     return target
 
 
 def _check_factor(factor, label="factor") -> float:
     factor = float(factor)
     if not np.isfinite(factor):
-        raise ValueError(f"{label} must be finite, got {factor}")
+        raise ParameterError(f"{label} must be finite, got {factor}")
     return factor
 
 
@@ -317,17 +317,17 @@ def scale_record(
     if v is not None and v.shape != h.shape:
         raise RecordError("<vertical>", f"has {v.size} samples but the horizontal has {h.size}")
     if vertical_mode not in VERTICAL_MODES:
-        raise ValueError(f"vertical_mode must be one of {VERTICAL_MODES}, got {vertical_mode!r}")
+        raise ParameterError(f"vertical_mode must be one of {VERTICAL_MODES}, got {vertical_mode!r}")
     independent_opts = (vertical_target, vertical_factor, vertical_measure, vertical_period)
     if vertical_mode != "independent" and any(x is not None for x in independent_opts):
-        raise ValueError(
+        raise ParameterError(
             "vertical_target/vertical_factor/vertical_measure/vertical_period apply only to "
             f"vertical_mode='independent', not {vertical_mode!r}"
         )
 
     # horizontal
     if target is not None and factor is not None:
-        raise ValueError("give either target or factor, not both")
+        raise ParameterError("give either target or factor, not both")
     if target is not None:
         f_h = amplitude_factor(h, dt, target, measure, period, damping, label="<horizontal>")
         h_measure = measure
@@ -335,7 +335,7 @@ def scale_record(
         _check_measure(measure, period, damping)
         f_h = 1.0 if factor is None else _check_factor(factor)
         if f_h <= 0.0:
-            raise ValueError(f"factor must be > 0 (use reverse=True to flip polarity), got {f_h}")
+            raise ParameterError(f"factor must be > 0 (use reverse=True to flip polarity), got {f_h}")
         h_measure = measure
     if reverse:
         f_h = -f_h
@@ -345,7 +345,7 @@ def scale_record(
     # vertical
     if v is None:
         if vertical_mode == "independent":
-            raise ValueError("vertical_mode='independent' needs a vertical component")
+            raise ParameterError("vertical_mode='independent' needs a vertical component")
         return ScaledRecord(h_out, None, f_h, None, h_measure, achieved, None)
     v_measure, v_period = measure, period
     if vertical_mode == "same":
@@ -356,7 +356,7 @@ def scale_record(
         f_v = 0.0
     else:
         if (vertical_target is None) == (vertical_factor is None):
-            raise ValueError(
+            raise ParameterError(
                 "vertical_mode='independent' needs exactly one of vertical_target and "
                 "vertical_factor"
             )
@@ -378,7 +378,7 @@ def scale_record(
             _check_measure(v_measure, v_period, damping)
             f_v = _check_factor(vertical_factor, "vertical_factor")
             if f_v <= 0.0:
-                raise ValueError(
+                raise ParameterError(
                     f"vertical_factor must be > 0 (use reverse_vertical=True), got {f_v}"
                 )
     if reverse_vertical and f_v != 0.0:

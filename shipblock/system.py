@@ -13,6 +13,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from shipblock.errors import ParameterError
 from shipblock.units import STANDARD_GRAVITY
 
 IMPACT_RULES = ("momentum", "paper")
@@ -135,31 +136,31 @@ class ShipBlockSystem:
             if not (isinstance(value, int | float | np.floating | np.integer)) or not (
                 math.isfinite(value) and value > 0
             ):
-                raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+                raise ParameterError(f"{name} must be a finite number > 0, got {value!r}")
 
         for name in ("ship_mass", "block_mass", "half_width", "half_height", "g"):
             positive(name)
         if int(self.n_blocks) != self.n_blocks or self.n_blocks < 1:
-            raise ValueError(f"n_blocks must be a whole number >= 1, got {self.n_blocks!r}")
+            raise ParameterError(f"n_blocks must be a whole number >= 1, got {self.n_blocks!r}")
         for name in ("mu_s_ground", "mu_k_ground", "mu_s_ship", "mu_k_ship"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+                raise ParameterError(f"{name} must be a finite number >= 0, got {value!r}")
         for iface in ("ground", "ship"):
             mus, muk = getattr(self, f"mu_s_{iface}"), getattr(self, f"mu_k_{iface}")
             if muk > mus:
-                raise ValueError(
+                raise ParameterError(
                     f"mu_k_{iface} ({muk}) must not exceed mu_s_{iface} ({mus}): kinetic friction "
                     "above static friction is not physical"
                 )
         if self.restitution is not None and not (0.0 <= self.restitution <= 1.0):
-            raise ValueError(f"restitution must lie in [0, 1], got {self.restitution!r}")
+            raise ParameterError(f"restitution must lie in [0, 1], got {self.restitution!r}")
         if self.impact_rule not in IMPACT_RULES:
-            raise ValueError(f"impact_rule must be one of {IMPACT_RULES}, got {self.impact_rule!r}")
+            raise ParameterError(f"impact_rule must be one of {IMPACT_RULES}, got {self.impact_rule!r}")
         if self.block_inertia is not None and not (
             math.isfinite(self.block_inertia) and self.block_inertia > 0
         ):
-            raise ValueError(f"block_inertia must be a finite number > 0, got {self.block_inertia!r}")
+            raise ParameterError(f"block_inertia must be a finite number > 0, got {self.block_inertia!r}")
 
     # Derived quantities ------------------------------------------------------------------
     @property
@@ -254,13 +255,13 @@ class ShipBlockSystem:
         known = set(cls.__dataclass_fields__)
         unknown = sorted(set(values) - known)
         if unknown:
-            raise ValueError(f"{source}: unknown system parameter(s) {unknown}; known: {sorted(known)}")
+            raise ParameterError(f"{source}: unknown system parameter(s) {unknown}; known: {sorted(known)}")
         try:
             return cls(**values)
         except TypeError as exc:
-            raise ValueError(f"{source}: {exc}") from None
+            raise ParameterError(f"{source}: {exc}") from None
         except ValueError as exc:
-            raise ValueError(f"{source}: {exc}") from None
+            raise ParameterError(f"{source}: {exc}") from None
 
     @classmethod
     def from_toml(cls, path) -> ShipBlockSystem:
@@ -271,7 +272,7 @@ class ShipBlockSystem:
             try:
                 data = tomllib.load(fh)
             except tomllib.TOMLDecodeError as exc:
-                raise ValueError(f"{path}: not valid TOML: {exc}") from None
+                raise ParameterError(f"{path}: not valid TOML: {exc}") from None
         return cls.from_mapping(data, source=str(path))
 
     def replace(self, **changes) -> ShipBlockSystem:

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from shipblock.errors import ParameterError
+
 #: Standard acceleration of gravity [m/s^2] (CGPM 1901, ISO 80000-3).
 STANDARD_GRAVITY = 9.80665
 
@@ -46,7 +48,7 @@ def _to_si(values, unit: str, table: dict[str, float], quantity: str):
         factor = table[unit.strip().lower()]
     except KeyError:
         known = ", ".join(sorted(table))
-        raise ValueError(f"unknown {quantity} unit {unit!r}; known units: {known}") from None
+        raise ParameterError(f"unknown {quantity} unit {unit!r}; known units: {known}") from None
     return np.asarray(values, dtype=float) * factor
 
 

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from shipblock.errors import ParameterError
 from shipblock.intensity import DEFAULT_DAMPING
 from shipblock.system import ShipBlockSystem
 
@@ -121,14 +122,14 @@ def apply_parameters(system: ShipBlockSystem, values: Mapping[str, object]) -> S
     """
     unknown = [k for k in values if k not in SWEEP_PARAMETERS]
     if unknown:
-        raise ValueError(
+        raise ParameterError(
             f"unknown system parameter(s) {', '.join(map(repr, unknown))}; known: "
             f"{', '.join(SWEEP_PARAMETERS)}"
         )
     for conv, plain in _CONFLICTS.items():
         clash = [p for p in plain if conv in values and p in values]
         if clash:
-            raise ValueError(f"{conv!r} and {clash[0]!r} both set the same parameter; give one")
+            raise ParameterError(f"{conv!r} and {clash[0]!r} both set the same parameter; give one")
     plain = {k: v for k, v in values.items() if k not in _CONVENIENCES}
     if "n_blocks" in plain:
         plain["n_blocks"] = _whole(plain["n_blocks"], "n_blocks")
@@ -151,9 +152,9 @@ def apply_parameters(system: ShipBlockSystem, values: Mapping[str, object]) -> S
 
 def _whole(value, name):
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
-        raise ValueError(f"{name} must be a whole number, got {value!r}")
+        raise ParameterError(f"{name} must be a whole number, got {value!r}")
     if int(value) != value:
-        raise ValueError(f"{name} must be a whole number, got {value!r}")
+        raise ParameterError(f"{name} must be a whole number, got {value!r}")
     return int(value)
 
 
@@ -232,40 +233,40 @@ class IntensityDesign:
             Naming the offending field.
         """
         if self.kind not in DESIGN_TYPES:
-            raise ValueError(f"type must be one of {DESIGN_TYPES}, got {self.kind!r}")
+            raise ParameterError(f"type must be one of {DESIGN_TYPES}, got {self.kind!r}")
         if self.measure not in IM_MEASURES:
-            raise ValueError(f"measure must be one of {tuple(IM_MEASURES)}, got {self.measure!r}")
+            raise ParameterError(f"measure must be one of {tuple(IM_MEASURES)}, got {self.measure!r}")
         if self.measure == "sa":
             if self.period is None or not (math.isfinite(self.period) and self.period > 0):
-                raise ValueError(f"period [s] must be > 0 for measure 'sa', got {self.period!r}")
+                raise ParameterError(f"period [s] must be > 0 for measure 'sa', got {self.period!r}")
         elif self.period is not None:
-            raise ValueError(f"period applies only to measure 'sa', not {self.measure!r}")
+            raise ParameterError(f"period applies only to measure 'sa', not {self.measure!r}")
         if not (0.0 <= self.damping < 1.0):
-            raise ValueError(f"damping must lie in [0, 1), got {self.damping!r}")
+            raise ParameterError(f"damping must lie in [0, 1), got {self.damping!r}")
         if self.vertical not in VERTICAL_MODES:
-            raise ValueError(f"vertical must be one of {VERTICAL_MODES}, got {self.vertical!r}")
+            raise ParameterError(f"vertical must be one of {VERTICAL_MODES}, got {self.vertical!r}")
         levels = np.asarray(self.levels, dtype=float)
         if self.scaled:
             if levels.size == 0:
-                raise ValueError(f"a {self.kind!r} design needs at least one IM level")
+                raise ParameterError(f"a {self.kind!r} design needs at least one IM level")
             if not (np.all(np.isfinite(levels)) and np.all(levels > 0)):
-                raise ValueError("levels must be finite and positive")
+                raise ParameterError("levels must be finite and positive")
             if np.any(np.diff(levels) <= 0):
-                raise ValueError("levels must be strictly increasing")
+                raise ParameterError("levels must be strictly increasing")
         elif levels.size:
-            raise ValueError("a 'cloud' design uses the records as recorded; remove the levels")
+            raise ParameterError("a 'cloud' design uses the records as recorded; remove the levels")
         if self.vertical == "independent":
             if not self.scaled:
-                raise ValueError("vertical 'independent' needs scaled levels (not a cloud)")
+                raise ParameterError("vertical 'independent' needs scaled levels (not a cloud)")
             v = np.asarray(self.vertical_levels if self.vertical_levels is not None else [])
             if v.shape != levels.shape:
-                raise ValueError(
+                raise ParameterError(
                     f"vertical_levels must give one vertical target per level ({levels.size})"
                 )
             if not (np.all(np.isfinite(v)) and np.all(v > 0)):
-                raise ValueError("vertical_levels must be finite and positive")
+                raise ParameterError("vertical_levels must be finite and positive")
         elif self.vertical_levels is not None:
-            raise ValueError("vertical_levels apply only to vertical = 'independent'")
+            raise ParameterError("vertical_levels apply only to vertical = 'independent'")
         return self
 
     def scale_options(self, level_index: int) -> dict:
@@ -337,22 +338,22 @@ class AnalysisDesign:
             the parameter values).
         """
         if not self.records:
-            raise ValueError("the design has no records")
+            raise ParameterError("the design has no records")
         if len(set(self.records)) != len(self.records):
-            raise ValueError("record ids repeat in the design")
+            raise ParameterError("record ids repeat in the design")
         self.intensity.validate()
         names = [name for name, _ in self.sweep]
         if len(set(names)) != len(names):
-            raise ValueError("a parameter is swept twice")
+            raise ParameterError("a parameter is swept twice")
         for name, values in self.sweep:
             if name not in SWEEP_PARAMETERS:
-                raise ValueError(
+                raise ParameterError(
                     f"unknown sweep parameter {name!r}; known: {', '.join(SWEEP_PARAMETERS)}"
                 )
             if len(values) == 0:
-                raise ValueError(f"sweep {name!r} has no values")
+                raise ParameterError(f"sweep {name!r} has no values")
             if len(set(values)) != len(values):
-                raise ValueError(f"sweep {name!r} repeats a value")
+                raise ParameterError(f"sweep {name!r} repeats a value")
         if self.stripes is not None:
             self._validate_stripes()
         self.systems()
@@ -360,22 +361,22 @@ class AnalysisDesign:
 
     def _validate_stripes(self) -> None:
         if self.intensity.kind != "msa":
-            raise ValueError("stripes (a record set per level) apply only to type 'msa'")
+            raise ParameterError("stripes (a record set per level) apply only to type 'msa'")
         if len(self.stripes) != self.intensity.n_levels:
-            raise ValueError(f"stripes must give one record list per level "
+            raise ParameterError(f"stripes must give one record list per level "
                              f"({self.intensity.n_levels}), got {len(self.stripes)}")
         for j, stripe in enumerate(self.stripes):
             if not stripe:
-                raise ValueError(f"stripe {j} has no records")
+                raise ParameterError(f"stripe {j} has no records")
             unknown = [r for r in stripe if r not in self.records]
             if unknown:
-                raise ValueError(f"stripe {j}: {', '.join(map(repr, unknown))} not among the "
+                raise ParameterError(f"stripe {j}: {', '.join(map(repr, unknown))} not among the "
                                  "design's records")
             if len(set(stripe)) != len(stripe):
-                raise ValueError(f"stripe {j} repeats a record")
+                raise ParameterError(f"stripe {j} repeats a record")
         unused = [r for r in self.records if not any(r in s for s in self.stripes)]
         if unused:
-            raise ValueError(f"records in no stripe: {', '.join(unused)}")
+            raise ParameterError(f"records in no stripe: {', '.join(unused)}")
 
     def stripe_mask(self) -> np.ndarray:
         """Which (record, level) pairs are run.
@@ -460,7 +461,7 @@ class AnalysisDesign:
             try:
                 out.append(apply_parameters(self.system, values))
             except ValueError as exc:
-                raise ValueError(f"sweep {values}: {exc}") from None
+                raise ParameterError(f"sweep {values}: {exc}") from None
         return out
 
     def case_indices(self, cases) -> np.ndarray:
@@ -498,7 +499,7 @@ class AnalysisDesign:
             Consecutive ranges covering ``range(n_cases)``.
         """
         if int(chunk_size) != chunk_size or chunk_size < 1:
-            raise ValueError(f"chunk_size must be a whole number >= 1, got {chunk_size!r}")
+            raise ParameterError(f"chunk_size must be a whole number >= 1, got {chunk_size!r}")
         n = self.n_cases
         return [range(a, min(a + int(chunk_size), n)) for a in range(0, n, int(chunk_size))]
 

@@ -50,7 +50,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from scipy import optimize, special, stats
 
-from shipblock.errors import ShipblockError
+from shipblock.errors import ParameterError, ShipblockError
 
 __all__ = [
     "BootstrapResult",
@@ -315,7 +315,7 @@ def fit_mle(im_levels, n_exceed, n_total, *, fixed_beta=None) -> FragilityFit:
     if fixed_beta is not None:
         beta = float(fixed_beta)
         if not (np.isfinite(beta) and beta > 0):
-            raise ValueError(f"fixed_beta must be a positive finite number, got {fixed_beta!r}")
+            raise ParameterError(f"fixed_beta must be a positive finite number, got {fixed_beta!r}")
         if not np.any(k > 0):
             raise FragilityFitError(
                 "no exceedances at any IM level: the median is only bounded below by the "
@@ -439,19 +439,19 @@ def _validate_counts(im_levels, n_exceed, n_total):
     k = np.asarray(n_exceed)
     n = np.asarray(n_total)
     if x.ndim != 1 or k.shape != x.shape or n.shape != x.shape:
-        raise ValueError(
+        raise ParameterError(
             "im_levels, n_exceed and n_total must be 1-D arrays of the same length, got shapes "
             f"{x.shape}, {k.shape}, {n.shape}"
         )
     if not np.all(np.isfinite(x) & (x > 0)):
-        raise ValueError("im_levels must be finite and positive [IM units]")
+        raise ParameterError("im_levels must be finite and positive [IM units]")
     for name, arr in (("n_exceed", k), ("n_total", n)):
         if not np.all(np.isfinite(arr)) or np.any(arr < 0) or np.any(arr != np.round(arr)):
-            raise ValueError(f"{name} must hold non-negative integers")
+            raise ParameterError(f"{name} must hold non-negative integers")
     k = k.astype(float)
     n = n.astype(float)
     if np.any(k > n):
-        raise ValueError("n_exceed cannot exceed n_total at any IM level")
+        raise ParameterError("n_exceed cannot exceed n_total at any IM level")
     return x, k, n
 
 
@@ -483,12 +483,12 @@ def fit_msa(exceeded, im_levels, valid=None, *, fixed_beta=None) -> FragilityFit
     e = np.asarray(exceeded, dtype=bool)
     x = np.asarray(im_levels, dtype=float)
     if e.ndim != 2 or e.shape[1] != x.size:
-        raise ValueError(
+        raise ParameterError(
             f"exceeded must have shape (n_records, {x.size}) to match im_levels, got {e.shape}"
         )
     w = np.ones_like(e) if valid is None else np.asarray(valid, dtype=bool)
     if w.shape != e.shape:
-        raise ValueError(f"valid must have the shape of exceeded {e.shape}, got {w.shape}")
+        raise ParameterError(f"valid must have the shape of exceeded {e.shape}, got {w.shape}")
     return fit_mle(x, np.sum(e & w, axis=0), np.sum(w, axis=0), fixed_beta=fixed_beta)
 
 
@@ -555,14 +555,14 @@ def ida_capacities(exceeded, im_levels, valid=None) -> IDACapacities:
     e = np.asarray(exceeded, dtype=bool)
     x = np.asarray(im_levels, dtype=float)
     if e.ndim != 2 or e.shape[1] != x.size:
-        raise ValueError(
+        raise ParameterError(
             f"exceeded must have shape (n_records, {x.size}) to match im_levels, got {e.shape}"
         )
     if not (np.all(x > 0) and np.all(np.diff(x) > 0)):
-        raise ValueError("im_levels must be positive and strictly increasing [IM units]")
+        raise ParameterError("im_levels must be positive and strictly increasing [IM units]")
     w = np.ones_like(e) if valid is None else np.asarray(valid, dtype=bool)
     if w.shape != e.shape:
-        raise ValueError(f"valid must have the shape of exceeded {e.shape}, got {w.shape}")
+        raise ParameterError(f"valid must have the shape of exceeded {e.shape}, got {w.shape}")
     hit = e & w
     ever = hit.any(axis=1)
     first = np.argmax(hit, axis=1)
@@ -634,28 +634,28 @@ def fit_ida(capacities, censored_at=None, *, method="mle") -> FragilityFit:
     """
     c = np.asarray(capacities, dtype=float)
     if c.ndim != 1:
-        raise ValueError(f"capacities must be 1-D, got shape {c.shape}")
+        raise ParameterError(f"capacities must be 1-D, got shape {c.shape}")
     if np.any(np.isnan(c)):
-        raise ValueError(
+        raise ParameterError(
             "capacities contain NaN; drop missing records, or give inf for records that never "
             "exceeded"
         )
     if np.any(c <= 0):
-        raise ValueError("capacities must be positive [IM units]")
+        raise ParameterError("capacities must be positive [IM units]")
     if censored_at is None:
         if not np.all(np.isfinite(c)):
-            raise ValueError("capacities that never exceeded (inf) need censored_at")
+            raise ParameterError("capacities that never exceeded (inf) need censored_at")
         cmax = np.full_like(c, np.inf)
     else:
         cmax = np.broadcast_to(np.asarray(censored_at, dtype=float), c.shape)
     censored = ~np.isfinite(c) | (c > cmax)
     if np.any(censored & ~(np.isfinite(cmax) & (cmax > 0))):
-        raise ValueError("censored records need a finite positive censored_at [IM units]")
+        raise ParameterError("censored records need a finite positive censored_at [IM units]")
     n_censored = int(censored.sum())
     if method == "moments":
         return _fit_ida_moments(np.where(censored, cmax, c), n_censored)
     if method != "mle":
-        raise ValueError(f"method must be 'mle' or 'moments', got {method!r}")
+        raise ParameterError(f"method must be 'mle' or 'moments', got {method!r}")
 
     y = np.log(c[~censored])
     y_cens = np.log(cmax[censored])
@@ -804,23 +804,23 @@ def fit_cloud(im, edp, capacity, *, method="regression", capacity_beta=0.0) -> F
     x = np.asarray(im, dtype=float)
     d = np.asarray(edp, dtype=float)
     if x.ndim != 1 or d.shape != x.shape:
-        raise ValueError(f"im and edp must be 1-D of equal length, got {x.shape} and {d.shape}")
+        raise ParameterError(f"im and edp must be 1-D of equal length, got {x.shape} and {d.shape}")
     if not np.all(np.isfinite(x) & (x > 0)):
-        raise ValueError("im must be finite and positive [IM units]")
+        raise ParameterError("im must be finite and positive [IM units]")
     capacity = float(capacity)
     if not (np.isfinite(capacity) and capacity > 0):
-        raise ValueError(f"capacity must be finite and positive, got {capacity!r}")
+        raise ParameterError(f"capacity must be finite and positive, got {capacity!r}")
     if method == "probit":
         if capacity_beta:
-            raise ValueError("capacity_beta is only used with method='regression'")
+            raise ParameterError("capacity_beta is only used with method='regression'")
         if np.any(np.isnan(d)):
-            raise ValueError("edp contains NaN: drop errored runs before fitting")
+            raise ParameterError("edp contains NaN: drop errored runs before fitting")
         fit = fit_mle(x, (d > capacity).astype(int), np.ones(x.size, dtype=int))
         return replace(fit, method="cloud_probit")
     if method != "regression":
-        raise ValueError(f"method must be 'regression' or 'probit', got {method!r}")
+        raise ParameterError(f"method must be 'regression' or 'probit', got {method!r}")
     if not np.all(np.isfinite(d) & (d > 0)):
-        raise ValueError(
+        raise ParameterError(
             "edp must be finite and positive for the cloud regression; remove collapsed or "
             "errored runs (or use method='probit')"
         )
@@ -940,12 +940,12 @@ def bootstrap(
        Hall, ch. 13.
     """
     if not 0 < confidence < 1:
-        raise ValueError(f"confidence must be in (0, 1), got {confidence!r}")
+        raise ParameterError(f"confidence must be in (0, 1), got {confidence!r}")
     arrays = {name: np.asarray(value) for name, value in records.items()}
     lengths = {name: a.shape[0] if a.ndim else None for name, a in arrays.items()}
     n_rec = set(lengths.values())
     if len(n_rec) != 1 or None in n_rec:
-        raise ValueError(f"all record arrays need the same length along axis 0, got {lengths}")
+        raise ParameterError(f"all record arrays need the same length along axis 0, got {lengths}")
     (n_rec,) = n_rec
     rng = np.random.default_rng(seed)
     base = fit_function(**arrays, **fit_kwargs)
@@ -969,7 +969,7 @@ def bootstrap(
         medians.append(f.median)
         betas.append(f.beta)
     if len(medians) < max(2, n_boot / 2):
-        raise ValueError(
+        raise ParameterError(
             f"only {len(medians)} of {n_boot} bootstrap refits succeeded; the data are too "
             "sparse for a bootstrap"
         )

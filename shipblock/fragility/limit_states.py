@@ -40,6 +40,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from shipblock.errors import ParameterError
+
 __all__ = [
     "CONDITIONS",
     "EDP_VARIABLES",
@@ -163,46 +165,46 @@ class LimitState:
         """
         who = f"limit state {self.name!r}"
         if not isinstance(self.name, str) or not self.name.strip():
-            raise ValueError(f"limit state name must be a non-empty string, got {self.name!r}")
+            raise ParameterError(f"limit state name must be a non-empty string, got {self.name!r}")
         if self.edp not in EDP_VARIABLES:
             hint = (
                 " (failure_time is not an EDP; use edp = 'failure')"
                 if self.edp == "failure_time"
                 else ""
             )
-            raise ValueError(
+            raise ParameterError(
                 f"{who}: unknown edp {self.edp!r}{hint}; known EDPs: {', '.join(EDP_VARIABLES)}"
             )
         if self.condition not in CONDITIONS:
-            raise ValueError(
+            raise ParameterError(
                 f"{who}: unknown condition {self.condition!r}; use one of {', '.join(CONDITIONS)}"
             )
         info = EDP_VARIABLES[self.edp]
         if info.kind not in CONDITIONS[self.condition]:
             usable = [c for c, kinds in CONDITIONS.items() if info.kind in kinds]
-            raise ValueError(
+            raise ParameterError(
                 f"{who}: condition {self.condition!r} does not apply to {info.kind} EDP "
                 f"{self.edp!r}; use one of {', '.join(usable)}"
             )
         if self.condition not in _NEEDS_THRESHOLD:
             if self.threshold is not None:
-                raise ValueError(
+                raise ParameterError(
                     f"{who}: threshold is not used with condition {self.condition!r}; remove it"
                 )
             return self
         t = self.threshold
         if t is None:
-            raise ValueError(f"{who}: missing threshold (condition {self.condition!r})")
+            raise ParameterError(f"{who}: missing threshold (condition {self.condition!r})")
         if isinstance(t, bool) or not isinstance(t, numbers.Real) or not math.isfinite(t):
-            raise ValueError(f"{who}: threshold must be a finite number, got {t!r}")
+            raise ParameterError(f"{who}: threshold must be a finite number, got {t!r}")
         if info.kind == "code":
             if t not in FAILURE_CODES or t == 0:
-                raise ValueError(
+                raise ParameterError(
                     f"{who}: threshold {t!r} is not a failure code; use 1 (separation) or "
                     "2 (overturning)"
                 )
         elif t < 0:
-            raise ValueError(
+            raise ParameterError(
                 f"{who}: threshold {t!r} [{info.units}] is negative but {self.edp!r} is compared "
                 "as a non-negative magnitude"
             )
@@ -234,7 +236,7 @@ def parse_limit_states(entries: Sequence[Mapping[str, Any]]) -> tuple[LimitState
         ``name``/``edp``, duplicate name, or any check of :meth:`LimitState.validate`.
     """
     if isinstance(entries, (str, bytes, Mapping)) or not isinstance(entries, Sequence):
-        raise ValueError(
+        raise ParameterError(
             "limit_states must be a list of tables ([[limit_states]] in TOML), got "
             f"{type(entries).__name__}"
         )
@@ -243,18 +245,18 @@ def parse_limit_states(entries: Sequence[Mapping[str, Any]]) -> tuple[LimitState
     for i, entry in enumerate(entries):
         where = f"limit_states[{i}]"
         if not isinstance(entry, Mapping):
-            raise ValueError(f"{where}: expected a table, got {type(entry).__name__}")
+            raise ParameterError(f"{where}: expected a table, got {type(entry).__name__}")
         if "name" in entry:
             where += f" ({entry['name']!r})"
         unknown = sorted(set(entry) - set(_KEYS))
         if unknown:
-            raise ValueError(
+            raise ParameterError(
                 f"{where}: unknown key(s) {', '.join(map(repr, unknown))}; allowed keys: "
                 f"{', '.join(_KEYS)}"
             )
         for key in ("name", "edp"):
             if key not in entry:
-                raise ValueError(f"{where}: missing required key {key!r}")
+                raise ParameterError(f"{where}: missing required key {key!r}")
         ls = LimitState(
             name=entry["name"],
             edp=entry["edp"],
@@ -265,9 +267,9 @@ def parse_limit_states(entries: Sequence[Mapping[str, Any]]) -> tuple[LimitState
         try:
             ls.validate()
         except ValueError as err:
-            raise ValueError(f"{where}: {err}") from None
+            raise ParameterError(f"{where}: {err}") from None
         if ls.name in seen:
-            raise ValueError(
+            raise ParameterError(
                 f"{where}: duplicate limit state name {ls.name!r} (first defined in "
                 f"limit_states[{seen[ls.name]}])"
             )
@@ -361,7 +363,7 @@ def exceedance(limit_state: LimitState, summary) -> Exceedance:
     if info.response:
         failure = _get(summary, "failure", ls.name)
         if not hasattr(value, "dims") and np.shape(failure) != np.shape(value):
-            raise ValueError(
+            raise ParameterError(
                 f"summary variables {ls.edp!r} {np.shape(value)} and 'failure' "
                 f"{np.shape(failure)} differ in shape"
             )

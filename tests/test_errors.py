@@ -1,0 +1,43 @@
+"""Bad input raises the project's own errors: one ``except ShipblockError`` catches them all,
+and they stay ValueErrors for code that expects the conventional type."""
+
+import numpy as np
+import pytest
+
+from shipblock import ShipBlockSystem, intensity, scaling
+from shipblock.errors import ParameterError, RecordError, ShipblockError
+from shipblock.fragility.design import AnalysisDesign, IntensityDesign
+from shipblock.fragility.fit import fit_mle
+from shipblock.fragility.limit_states import LimitState
+from shipblock.units import acceleration_to_si, velocity_to_si
+
+ACC = np.sin(np.linspace(0.0, 10.0, 500))
+
+CASES = {
+    "negative ship mass": (lambda: ShipBlockSystem.example().replace(ship_mass=-1.0),
+                           "ship_mass"),
+    "kinetic above static": (lambda: ShipBlockSystem.example().replace(mu_k_ship=0.9),
+                             "mu_k_ship"),
+    "zero dt": (lambda: intensity.pga(ACC, 0.0), "dt"),
+    "negative period": (lambda: intensity.response_spectrum(ACC, 0.01, [-1.0]), "periods"),
+    "unknown measure": (lambda: scaling.measure_value(ACC, 0.01, "pgx"), "pgx"),
+    "negative target": (lambda: scaling.amplitude_factor(ACC, 0.01, target=-1.0), "target"),
+    "unknown acceleration unit": (lambda: acceleration_to_si(1.0, "furlong/s^2"), "furlong"),
+    "unknown velocity unit": (lambda: velocity_to_si(1.0, "knots"), "knots"),
+    "decreasing levels": (lambda: IntensityDesign("ida", levels=(2.0, 1.0)).validate(),
+                          "increasing"),
+    "empty design": (lambda: AnalysisDesign((), IntensityDesign("cloud"),
+                                            ShipBlockSystem.example()).validate(), "records"),
+    "counts above totals": (lambda: fit_mle([1.0, 2.0], [3, 1], [2, 2]), "n_exceed"),
+    "unknown EDP": (lambda: LimitState("x", "ship_slipp", 0.1).validate(), "ship_slipp"),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_bad_input_raises_a_named_shipblock_error(case):
+    make, named = CASES[case]
+    with pytest.raises(ShipblockError) as info:
+        make()
+    assert isinstance(info.value, ValueError)
+    assert isinstance(info.value, ParameterError | RecordError)
+    assert named in str(info.value), str(info.value)
