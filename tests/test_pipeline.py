@@ -265,6 +265,23 @@ def test_pgv_levels_are_velocities_in_si(tmp_path, levels, expected, error):
     assert design.intensity.units == "m/s"
 
 
+def test_system_by_slenderness_and_mass_ratio(tmp_path):
+    path = write_pipeline(tmp_path)
+    text = path.read_text()
+    path.write_text(text.replace("block_mass = 1200.0", "mass_ratio = 0.036")
+                    .replace("half_width = 0.3", "slenderness = 0.5"))
+    system = load_pipeline(path).design.system
+    assert system.block_mass == pytest.approx(0.036 * 5.0e6 / 150, rel=1e-15)  # 1200 kg
+    assert system.half_width == pytest.approx(0.5 * 0.6, rel=1e-15)
+    for edit, key in [(("n_blocks = 150", "n_blocks = 150\nblock_mass = 1.0"), "system.mass_ratio"),
+                      (("mass_ratio = 0.036\n", ""), "system.block_mass")]:
+        path.write_text(text.replace("block_mass = 1200.0", "mass_ratio = 0.036")
+                        .replace(*edit))
+        with pytest.raises(PipelineError) as info:
+            load_pipeline(path)
+        assert info.value.key == key
+
+
 def test_cloud_design(tmp_path):
     path = write_pipeline(tmp_path, kind="cloud", levels="", n_records=3)
     ds = run_pipeline(path, progress=False)

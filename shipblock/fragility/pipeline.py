@@ -25,7 +25,7 @@ Schema (``schema_version = 1``; units in brackets, paths relative to the pipelin
     step = "demean"                     # processing = [] for no processing
 
     [system]                            # ShipBlockSystem fields [SI]; slenderness = B/H may
-    ship_mass = 5.0e6                   # replace half_width
+    ship_mass = 5.0e6                   # replace half_width, mass_ratio = n m / M block_mass
     ...
 
     [sweep]                             # optional; one dimension per parameter
@@ -224,6 +224,7 @@ _SCHEMA: dict[str, dict[str, tuple]] = {
         **{name: (_NUM, False) for name in SYSTEM_FIELDS if name != "impact_rule"},
         "impact_rule": ((str,), False),
         "slenderness": (_NUM, False),
+        "mass_ratio": (_NUM, False),
     },
     "design": {
         "type": ((str,), True),
@@ -250,7 +251,7 @@ _SCHEMA: dict[str, dict[str, tuple]] = {
     "histories": {"runs": ((list,), False), "exceeding": ((list,), False),
                   "max_runs": ((int,), False), "directory": ((str,), False)},
 }
-_REQUIRED_SYSTEM = ("ship_mass", "block_mass", "n_blocks", "half_height", "mu_s_ground",
+_REQUIRED_SYSTEM = ("ship_mass", "n_blocks", "half_height", "mu_s_ground",
                     "mu_k_ground", "mu_s_ship", "mu_k_ship")
 _TYPE_NAMES = {int: "an integer", float: "a number", str: "a string", list: "a list",
                dict: "a table", bool: "true/false"}
@@ -573,6 +574,18 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
         sys_table["half_width"] = float(sys_table.pop("slenderness")) * sys_table["half_height"]
     elif "half_width" not in sys_table:
         raise PipelineError("system.half_width", "missing (give half_width or slenderness)",
+                            source)
+    if "mass_ratio" in sys_table:
+        if "block_mass" in sys_table:
+            raise PipelineError("system.mass_ratio", "give mass_ratio or block_mass, not both",
+                                source)
+        n = sys_table["n_blocks"]
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise PipelineError("system.n_blocks", f"must be a whole number >= 1, got {n!r}",
+                                source)
+        sys_table["block_mass"] = float(sys_table.pop("mass_ratio")) * sys_table["ship_mass"] / n
+    elif "block_mass" not in sys_table:
+        raise PipelineError("system.block_mass", "missing (give block_mass or mass_ratio)",
                             source)
     try:
         system = ShipBlockSystem(**sys_table)
