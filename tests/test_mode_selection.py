@@ -65,7 +65,6 @@ def test_kernel_choice_equals_exhaustive_ranking(seed):
                              mu_s_ship=0.3, mu_k_ship=0.25)
     p = parameter_tuple(system.to_parameter_vector())
     w7 = np.zeros(7)
-    order = np.zeros(27, dtype=np.int64)
     ms = np.zeros(6, dtype=np.int64)
     n_checked = 0
     for _ in range(150):
@@ -83,7 +82,7 @@ def test_kernel_choice_equals_exhaustive_ranking(seed):
         # the kernel evaluates ONE_SIDED_DT after t; a constant record makes that moot
         ax_rec, ay_rec = np.full(4, a), np.full(4, ay)
         status = K.select_mode(p, y, ms, 0, 0.0, 0.01, ax_rec, ay_rec, True, 1.0, 1.0, trigger,
-                               w7, order)
+                               w7)
         want, consistent = reference_choice(system, y, a, ay, trigger)
         if status == 2:
             continue

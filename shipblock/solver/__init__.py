@@ -165,10 +165,20 @@ def simulate(
     hist = np.empty((K.N_HIST, n))  # one contiguous row per history
     modes = np.empty(n, dtype=np.int64)
     summary = np.empty(K.N_SUMMARY)
-    ev_t, ev_k, ev_f, ev_to = K.run(
-        p, ax, ay_arr, has_ay, 1.0, 1.0, float(dt), rtol, atol, zeno_omega, True, hist, modes,
-        summary, y_init,
-    )
+    # room in the event log for more events than samples; a run with even more (chattering
+    # contacts) is made again with room for all
+    log_size = n + 16
+    while True:
+        ev_t = np.empty(log_size)
+        ev_kft = np.empty((3, log_size), dtype=np.int64)
+        K.run(p, ax, ay_arr, has_ay, 1.0, 1.0, float(dt), rtol, atol, zeno_omega, True, hist,
+              modes, ev_t, ev_kft, summary, y_init)
+        n_ev = int(summary[K.S_N_EVENTS])
+        if n_ev <= log_size:
+            break
+        log_size = n_ev
+    ev_t = ev_t[:n_ev].copy()
+    ev_k, ev_f, ev_to = (ev_kft[i, :n_ev].copy() for i in range(3))
     time = np.arange(n) * float(dt)
     theta = hist[K.Y_TH]
     vb, om, vs = hist[K.Y_VB], hist[K.Y_OM], hist[K.Y_VS]

@@ -14,9 +14,16 @@ samples a and G are linear in time, so within a sample interval
 
 :func:`nonrocking_span` runs this loop over as many samples as the mode lasts without leaving
 compiled code or touching the general event machinery, which is what makes sliding and rest
-phases cheap (a few nanoseconds per sample at rest). It stops at the first event, with the
+phases cheap. At rest nothing moves and whether an interval may hold an event depends on the
+input at its end alone, so long rest phases are screened a block of samples at a time
+(:func:`skip_rest`, about a nanosecond per sample). The span stops at the first event, with the
 state advanced exactly to it (the same polynomials, cut at the root), and returns the event for
 the general kernel to apply.
+
+The functions called once per span or per event are compiled without numba's reference
+counting (``_nrt=False``; they neither allocate nor return arrays): it would otherwise update
+the counts of all their array arguments on every call, atomically, and the record and output
+arrays are shared by the runs that ``run_many`` executes in parallel.
 """
 
 from __future__ import annotations
@@ -70,6 +77,8 @@ from shipblock.solver._layout import (
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
 NO_ROOT = math.inf
+#: Samples screened at once at rest (see :func:`skip_rest`).
+REST_BLOCK = 32
 
 
 @njit(cache=True, error_model="numpy")
@@ -140,9 +149,19 @@ def slip_may_stop(sig, v0, u0, u1, h):
 
     ``sig v`` starts at ``sig v0`` with slope ``sig u0``; it is suspect if it ends negative or
     if its slope turns from negative to positive inside (a dip, checked exactly afterwards).
+
+    The test divides by ``2 h`` (the quadratic coefficient, as the root search uses it): a
+    division on the way to the screen's branch in every sliding sample. It is made only when
+    the same test without the division (the coefficient times ``h`` taken as
+    ``sig (u1 - u0) / 2``), with a margin far above the round-off between the two, cannot rule
+    the interval out; so the result is the same.
     """
-    c = sig * (u1 - u0) / (2.0 * h)
     d0 = sig * u0
+    dd = sig * (u1 - u0)
+    margin = 1e-12 * (abs(v0) + h * (abs(u0) + abs(u1)))
+    if sig * v0 + h * (d0 + 0.5 * dd) >= margin and (d0 >= 0.0 or d0 + dd <= -margin / h):
+        return False
+    c = dd / (2.0 * h)
     return sig * v0 + h * (d0 + c * h) < 0.0 or (d0 < 0.0 and d0 + 2.0 * c * h > 0.0)
 
 
@@ -175,9 +194,109 @@ def exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M
     y[Y_DIS] += h * (d0 + 4.0 * dm + d1) / 6.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
+def exact_update_one(y, ix, iv, h, u0, u1, a0, a1, f0, f1, m):
+    """As :func:`exact_update` when only one interface moves: slip ``y[ix]``, slip velocity
+    ``y[iv]``, its acceleration ``u``, friction force ``f`` and the mass ``m`` it carries.
+
+    The other interface's terms are products with its zero velocity and acceleration, so
+    leaving them out gives the same values with half the arithmetic.
+    """
+    v0 = y[iv]
+    v1 = v0 + 0.5 * h * (u0 + u1)
+    vm = v0 + 0.5 * h * u0 + 0.125 * h * (u1 - u0)
+    am = 0.5 * (a0 + a1)
+    r0 = -a0 * (m * v0)
+    rm = -am * (m * vm)
+    r1 = -a1 * (m * v1)
+    d0 = -(f0 * v0)
+    dm = -(0.5 * (f0 + f1) * vm)
+    d1 = -(f1 * v1)
+    y[ix] += h * v0 + h * h * (2.0 * u0 + u1) / 6.0
+    y[iv] = v1
+    y[Y_WIN] += h * (r0 + 4.0 * rm + r1) / 6.0
+    y[Y_DIS] += h * (d0 + 4.0 * dm + d1) / 6.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def rest_breaks(ax_j, ay_j, has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g,
+                mus1, mus2, B, H):
+    """Whether rest (mode 1, every event armed) fails the screen of :func:`nonrocking_span` at
+    the end of an interval whose end sample is ``ax_j``, ``ay_j``: the same expressions,
+    without branches.
+
+    At rest nothing moves, so the screen depends on the input at the end sample alone.
+    """
+    a1 = sh * ax_j
+    G1 = grav + (sv * ay_j if has_ay else 0.0)
+    fx1 = fx_a * a1 + fx_g * G1
+    fy1 = fy_a * a1 + fy_g * G1
+    Fx1 = Fx_a * a1 + Fx_g * G1
+    Fy1 = Fy_a * a1 + Fy_g * G1
+    return ((fy1 <= 0.0) | (Fy1 <= 0.0) | (B * (fy1 + Fy1) < H * abs(fx1 + Fx1))
+            | (mus1 * fy1 < abs(fx1)) | (mus2 * Fy1 < abs(Fx1)))
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g,
+              Fy_a, Fy_g, mus1, mus2, B, H):
+    """Advance rest from sample ``k`` over whole blocks of ``REST_BLOCK`` intervals that all
+    pass the screen (see :func:`rest_breaks`), stopping before the first that does not.
+
+    A block is screened at once, with no branches in the loop: vectorised, a fraction of the
+    cost of the sample-by-sample loop.
+
+    Parameters
+    ----------
+    ax, ay, has_ay, sh, sv, dt
+        Record and scale factors as in :func:`nonrocking_span`.
+    k : int
+        Sample at which rest goes on (``tau`` = 0).
+    time : float
+        Time in the mode so far [s].
+    grav, fx_a, ..., H : float
+        As :func:`rest_breaks` takes them.
+
+    Returns
+    -------
+    k : int
+        Where rest goes on sample by sample.
+    time : float
+        The time in the mode, with ``dt`` added interval by interval as the span adds it.
+    """
+    n = ax.shape[0]
+    while k + REST_BLOCK < n:
+        # indices from 0 in a slice, so that the loads are contiguous (no negative-index
+        # wraparound to allow for) and vectorise without gathers
+        bx = ax[k + 1:k + 1 + REST_BLOCK]
+        by = ay[k + 1:k + 1 + REST_BLOCK]
+        bad = 0
+        for j in range(REST_BLOCK):
+            bad += rest_breaks(bx[j], by[j], has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a,
+                               Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
+        if bad:
+            break
+        for _ in range(REST_BLOCK):
+            time += dt
+        k += REST_BLOCK
+    return k, time
+
+
+@njit(cache=True, inline="always")
+def response_slot(slip1, sig1, slip2, sig2):
+    """Row of the response cache of a non-rocking mode: 3 ground x 3 ship interface states.
+
+    An interface sticks (0) or slips forward (1) or backward (2); a sticking interface's sign
+    does not enter the equations.
+    """
+    g = 0 if not slip1 else (1 if sig1 > 0.0 else 2)
+    s = 0 if not slip2 else (1 if sig2 > 0.0 else 2)
+    return 3 * g + s
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
 def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary, peaks,
-                    store, hist, modes, resp, g):
+                    store, hist, modes, resp, resp_state, g):
     """Advance a non-rocking mode sample by sample until an event or the end of the record.
 
     Parameters
@@ -198,8 +317,13 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
         Running peaks of |x_b| and |x_s| at the samples.
     store, hist, modes
         History output, as in ``run``: each sample the span completes is written.
-    resp : ndarray, shape (2, 7)
-        Work array for the response vectors.
+    resp : ndarray, shape (9, 2, 7)
+        Response vectors ``w_a``, ``w_G`` of the non-rocking modes, one row per
+        :func:`response_slot`; solved on a mode's first span and reused by its later spans in
+        the run (a stick-slip record enters the same few modes thousands of times).
+    resp_state : ndarray of int, shape (9,)
+        Per slot: 0 not solved yet, 1 solved, 2 singular. Zero at the start of a run (the
+        vectors depend on the parameters).
     g : ndarray, shape (N_EVENTS,)
         Work array for the event functions.
 
@@ -214,11 +338,14 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
     n = ax.shape[0]
     slip1, slip2 = ms[MS_SLIP1], ms[MS_SLIP2]
     sig1, sig2 = float(ms[MS_SIG1]), float(ms[MS_SIG2])
-    wa = resp[0]
-    wg = resp[1]
-    ok_a = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
-    ok_g = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)
-    if not (ok_a and ok_g):
+    slot = response_slot(slip1, sig1, slip2, sig2)
+    wa = resp[slot, 0]
+    wg = resp[slot, 1]
+    if resp_state[slot] == 0:
+        ok_a = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
+        ok_g = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)
+        resp_state[slot] = 1 if ok_a and ok_g else 2
+    if resp_state[slot] == 2:
         return k, tau, -2
     ub_a, us_a, fx_a, fy_a, Fx_a, Fy_a = wa[I_XB_DD], wa[I_XS_DD], wa[I_FX], wa[I_FY], wa[I_SFX], wa[I_SFY]
     ub_g, us_g, fx_g, fy_g, Fx_g, Fy_g = wg[I_XB_DD], wg[I_XS_DD], wg[I_FX], wg[I_FY], wg[I_SFX], wg[I_SFY]
@@ -229,30 +356,52 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
     inv_w = 1.0 / (mass_b * grav)
     inv_ws = 1.0 / (M * grav)
     inv_wr = inv_w / p[P_R]
-    mode_slot = S_MODE_TIME + MODE_NUMBER[slip1, 0, slip2] - 1
+    mode = MODE_NUMBER[slip1, 0, slip2]
+    mode_slot = S_MODE_TIME + mode - 1
     all_armed = True
     for e in range(N_EVENTS):
         if not armed[e]:
             all_armed = False
-    a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # start of the interval
     time_in_mode = 0.0  # accumulated here, added to the summary when the span ends
+    if not slip1 and not slip2 and all_armed and y[Y_VB] == 0.0 and y[Y_VS] == 0.0:
+        # Rest: nothing moves and an interval passes the screen on the input at its end alone.
+        # The first intervals are screened one by one (rest often ends within a few), then
+        # whole blocks at once; the loop below takes over at the first that fails.
+        k_first = k
+        while k < n - 1 and k - k_first < REST_BLOCK and not rest_breaks(
+                ax[k + 1], ay[k + 1], has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g,
+                Fy_a, Fy_g, mus1, mus2, B, H):
+            time_in_mode += dt - tau
+            tau = 0.0
+            k += 1
+            if store:
+                _store(p, y, hist, modes, k, mode)
+        if k - k_first == REST_BLOCK:
+            k_first = k
+            k, time_in_mode = skip_rest(ax, ay, has_ay, sh, sv, k, dt, time_in_mode, grav, fx_a,
+                                        fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B,
+                                        H)
+            if store:
+                for j in range(k_first + 1, k + 1):
+                    _store(p, y, hist, modes, j, mode)
+    a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # start of the interval
+    G0 = grav + b0
+    fx0 = fx_a * a0 + fx_g * G0
+    fy0 = fy_a * a0 + fy_g * G0
+    Fx0 = Fx_a * a0 + Fx_g * G0
+    Fy0 = Fy_a * a0 + Fy_g * G0
+    ub0 = ub_a * a0 + ub_g * G0
+    us0 = us_a * a0 + us_g * G0
     while k < n - 1:
         h = dt - tau
         a1 = sh * ax[k + 1]
         b1 = sv * ay[k + 1] if has_ay else 0.0
-        G0 = grav + b0
         G1 = grav + b1
-        fx0 = fx_a * a0 + fx_g * G0
         fx1 = fx_a * a1 + fx_g * G1
-        fy0 = fy_a * a0 + fy_g * G0
         fy1 = fy_a * a1 + fy_g * G1
-        Fx0 = Fx_a * a0 + Fx_g * G0
         Fx1 = Fx_a * a1 + Fx_g * G1
-        Fy0 = Fy_a * a0 + Fy_g * G0
         Fy1 = Fy_a * a1 + Fy_g * G1
-        ub0 = ub_a * a0 + ub_g * G0
         ub1 = ub_a * a1 + ub_g * G1
-        us0 = us_a * a0 + us_g * G0
         us1 = us_a * a1 + us_g * G1
         vb0 = y[Y_VB]
         vs0 = y[Y_VS]
@@ -310,8 +459,15 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
                 summary[mode_slot] += time_in_mode + best_h
                 return k, tau + best_h, best_e
         # no event: advance exactly to the next sample
-        if slip1 or slip2 or vb0 != 0.0 or vs0 != 0.0:
-            exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M)
+        moving_b = slip1 or vb0 != 0.0
+        moving_s = slip2 or vs0 != 0.0
+        if moving_b or moving_s:
+            if not moving_s:
+                exact_update_one(y, Y_XB, Y_VB, h, ub0, ub1, a0, a1, fx0, fx1, mass_b)
+            elif not moving_b:
+                exact_update_one(y, Y_XS, Y_VS, h, us0, us1, a0, a1, Fx0, Fx1, M)
+            else:
+                exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M)
             axb = abs(y[Y_XB])
             if axb > peaks[0]:
                 peaks[0] = axb
@@ -321,8 +477,9 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
         time_in_mode += h
         k += 1
         tau = 0.0
+        # the end of this interval is the start of the next: the same values, not recomputed
         a0 = a1
-        b0 = b1
+        fx0, fy0, Fx0, Fy0, ub0, us0 = fx1, fy1, Fx1, Fy1, ub1, us1
         if not all_armed:
             event_functions(p, ms, y, fx1, fy1, Fx1, Fy1, g)
             all_armed = True
@@ -333,7 +490,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
                     else:
                         all_armed = False
         if store:
-            _store(p, y, hist, modes, k, MODE_NUMBER[slip1, 0, slip2])
+            _store(p, y, hist, modes, k, mode)
     summary[mode_slot] += time_in_mode
     return k, tau, -1
 

@@ -10,7 +10,9 @@ method on the step length (an impact starting from the root of the step's quinti
 interpolant). The state is advanced to the root, the event is applied, and the next mode is
 chosen among all candidate modes consistent with the velocities by :func:`select_mode`.
 
-Nothing here allocates per step; the kernels take only arrays and scalars.
+Nothing here allocates per step; the kernels take only arrays and scalars. Mode selection, like
+the closed-form span, is compiled without reference counting (see
+:mod:`~shipblock.solver._closed_form`).
 """
 
 from __future__ import annotations
@@ -371,8 +373,49 @@ def candidate_options(idx, vb, rot, vs):
     return slip1, sig1, new1, rock, s, newr, slip2, sig2, new2
 
 
-@njit(cache=True)
-def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7, order):
+def _candidate_order():
+    """The candidates of :func:`select_mode` in its order of preference, for every case.
+
+    The order depends only on which of ``vb``, ``rot``, ``vs`` are zero (``case`` =
+    4 [vb != 0] + 2 [rot != 0] + [vs != 0]) and on the trigger, so it is tabulated once here
+    instead of being sorted after every event.
+
+    Returns
+    -------
+    keys : ndarray of int, shape (8, 4, 27)
+        By case and trigger + 1, the candidates as ``(r * 16 + mode number) * 32 + idx``
+        (``r`` = 0 if the candidate releases the trigger, else 1; ``idx`` as in
+        :func:`candidate_options`), sorted by number of new motions, then key.
+    counts : ndarray of int, shape (8, 4)
+        How many of them exist.
+    """
+    option = interface_option.py_func  # plain Python: nothing is compiled at import
+    keys = np.zeros((8, 4, 27), dtype=np.int64)
+    counts = np.zeros((8, 4), dtype=np.int64)
+    for case in range(8):
+        vb, rot, vs = float(case >> 2), float((case >> 1) & 1), float(case & 1)
+        for trigger in range(-1, 3):
+            ranked = []
+            for idx in range(27):
+                slip1, _, new1 = option(vb, idx // 9)
+                rock, _, newr = option(rot, (idx // 3) % 3)
+                slip2, _, new2 = option(vs, idx % 3)
+                if slip1 < 0 or rock < 0 or slip2 < 0:
+                    continue
+                releases = (new1, newr, new2)[trigger] if trigger >= 0 else 0
+                mode = int(MODE_NUMBER[slip1, rock, slip2])
+                ranked.append((new1 + newr + new2, ((0 if releases else 1) * 16 + mode) * 32 + idx))
+            ranked.sort()
+            counts[case, trigger + 1] = len(ranked)
+            keys[case, trigger + 1, :len(ranked)] = [key for _, key in ranked]
+    return keys, counts
+
+
+CANDIDATE_KEYS, CANDIDATE_COUNTS = _candidate_order()
+
+
+@njit(cache=True, _nrt=False)
+def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
     """Choose the next mode among the candidates consistent with the velocities.
 
     Candidates: an interface with a nonzero slip velocity keeps slipping that way; one at zero
@@ -386,9 +429,9 @@ def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7, order
     If none is consistent, the one with the least total violation is taken.
 
     The candidates are visited in that order of preference (by number of new motions, then
-    trigger, then mode number; ``order`` is a work array of 27 integers), so the first
-    consistent one is the choice and the search stops there: after most events one or two
-    candidates are solved instead of up to 27.
+    trigger, then mode number; tabulated in ``CANDIDATE_KEYS``), so the first consistent one is
+    the choice and the search stops there: after most events one or two candidates are solved
+    instead of up to 27.
 
     Returns
     -------
@@ -409,62 +452,41 @@ def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7, order
     best_mode = 99
     best0 = best1 = best2 = best3 = best4 = best5 = 0
     all_separate = True
-    for level in range(4):
-        # this level's candidates, sorted by (releases the trigger, mode number, enumeration)
-        n_c = 0
-        # level 0 is candidate 0 alone (every interface goes on as it is)
-        for idx in range(1 if level == 0 else 27):
-            slip1, sig1, new1, rock, s, newr, slip2, sig2, new2 = candidate_options(idx, vb, rot, vs)
-            if slip1 < 0 or rock < 0 or slip2 < 0 or new1 + newr + new2 != level:
-                continue
-            if trigger == 0:
-                releases = new1
-            elif trigger == 1:
-                releases = newr
-            elif trigger == 2:
-                releases = new2
-            else:
-                releases = 0
-            key = ((0 if releases else 1) * 16 + mode_number_of(slip1, rock, slip2)) * 32 + idx
-            j = n_c
-            while j > 0 and order[j - 1] > key:
-                order[j] = order[j - 1]
-                j -= 1
-            order[j] = key
-            n_c += 1
-        for jc in range(n_c):
-            idx = order[jc] % 32
-            key2 = order[jc] // 512
-            mode = (order[jc] // 32) % 16
-            slip1, sig1, new1, rock, s, newr, slip2, sig2, new2 = candidate_options(idx, vb, rot, vs)
-            ok = solve_mode(p, slip1, rock, slip2, float(s), float(sig1), float(sig2),
-                            th, om, a, G, w7)
-            if not ok:
-                continue
-            fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
-            viol = 0.0
-            separate = fy <= 0.0 or Fy <= 0.0
-            if not separate:
-                all_separate = False
-            else:
-                viol += max(0.0, -fy / weight) + max(0.0, -Fy / ship_weight) + 1.0
-            # ground, rocking, ship: the constraint held, or the new motion's push
-            viol += interface_violation(
-                slip1 == 0, (abs(fx) - p[P_MUS1] * fy) / weight, new1, sig1 * w7[0] / p[P_G])
-            viol += interface_violation(
-                rock == 0, (p[P_H] * abs(fx + Fx) - p[P_B] * (fy + Fy)) / (weight * p[P_R]),
-                newr, s * w7[1] * p[P_R] / p[P_G])
-            viol += interface_violation(
-                slip2 == 0, (abs(Fx) - p[P_MUS2] * Fy) / ship_weight, new2, sig2 * w7[2] / p[P_G])
-            if viol == 0.0:
-                # the most preferred consistent candidate: the choice
-                ms[0], ms[1], ms[2], ms[3], ms[4], ms[5] = slip1, rock, slip2, s, sig1, sig2
-                return 0
-            if viol < best_viol or (viol == best_viol and (
-                    key2 < best_key2 or key2 == best_key2 and mode < best_mode)):
-                best_viol, best_key2, best_mode = viol, key2, mode
-                best0, best1, best2 = slip1, rock, slip2
-                best3, best4, best5 = s, sig1, sig2
+    case = (4 if vb != 0.0 else 0) + (2 if rot != 0.0 else 0) + (1 if vs != 0.0 else 0)
+    order = CANDIDATE_KEYS[case, trigger + 1]
+    for jc in range(CANDIDATE_COUNTS[case, trigger + 1]):
+        idx = order[jc] % 32
+        key2 = order[jc] // 512
+        mode = (order[jc] // 32) % 16
+        slip1, sig1, new1, rock, s, newr, slip2, sig2, new2 = candidate_options(idx, vb, rot, vs)
+        ok = solve_mode(p, slip1, rock, slip2, float(s), float(sig1), float(sig2),
+                        th, om, a, G, w7)
+        if not ok:
+            continue
+        fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
+        viol = 0.0
+        separate = fy <= 0.0 or Fy <= 0.0
+        if not separate:
+            all_separate = False
+        else:
+            viol += max(0.0, -fy / weight) + max(0.0, -Fy / ship_weight) + 1.0
+        # ground, rocking, ship: the constraint held, or the new motion's push
+        viol += interface_violation(
+            slip1 == 0, (abs(fx) - p[P_MUS1] * fy) / weight, new1, sig1 * w7[0] / p[P_G])
+        viol += interface_violation(
+            rock == 0, (p[P_H] * abs(fx + Fx) - p[P_B] * (fy + Fy)) / (weight * p[P_R]),
+            newr, s * w7[1] * p[P_R] / p[P_G])
+        viol += interface_violation(
+            slip2 == 0, (abs(Fx) - p[P_MUS2] * Fy) / ship_weight, new2, sig2 * w7[2] / p[P_G])
+        if viol == 0.0:
+            # the most preferred consistent candidate: the choice
+            ms[0], ms[1], ms[2], ms[3], ms[4], ms[5] = slip1, rock, slip2, s, sig1, sig2
+            return 0
+        if viol < best_viol or (viol == best_viol and (
+                key2 < best_key2 or key2 == best_key2 and mode < best_mode)):
+            best_viol, best_key2, best_mode = viol, key2, mode
+            best0, best1, best2 = slip1, rock, slip2
+            best3, best4, best5 = s, sig1, sig2
     if all_separate:
         return 2
     ms[0], ms[1], ms[2], ms[3], ms[4], ms[5] = best0, best1, best2, best3, best4, best5
@@ -473,24 +495,8 @@ def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7, order
 
 
 @njit(cache=True)
-def _grow(arr_t, arr_k, arr_f, arr_to, n):
-    if n < arr_t.shape[0]:
-        return arr_t, arr_k, arr_f, arr_to
-    m = 2 * arr_t.shape[0] + 16
-    t2 = np.empty(m)
-    k2 = np.empty(m, dtype=np.int64)
-    f2 = np.empty(m, dtype=np.int64)
-    to2 = np.empty(m, dtype=np.int64)
-    t2[:n] = arr_t[:n]
-    k2[:n] = arr_k[:n]
-    f2[:n] = arr_f[:n]
-    to2[:n] = arr_to[:n]
-    return t2, k2, f2, to2
-
-
-@njit(cache=True)
-def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes, summary,
-        y_init):
+def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes, ev_t,
+        ev_kft, summary, y_init):
     """Integrate one record.
 
     Parameters
@@ -514,15 +520,15 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
         each history is contiguous) and ``modes`` (n).
     hist, modes : ndarray
         History outputs (ignored unless ``store``).
+    ev_t, ev_kft : ndarray, shapes (m,) and (3, m)
+        Event log (filled when ``store``): time and (kind, mode before, mode after) of the
+        first ``m`` events. The caller sizes it (the count is ``summary[S_N_EVENTS]``; a log
+        too short is run again longer): a log grown in here would be an array reassigned in
+        the main loop, which numba reference-counts on every pass.
     summary : ndarray, shape (N_SUMMARY,)
         Receives the summary of the run.
     y_init : ndarray, shape (6,)
         Initial ``(x_b, theta, x_s, v_b, theta_dot, v_s)``.
-
-    Returns
-    -------
-    ev_time, ev_kind, ev_from, ev_to : ndarray
-        The event log (only filled when ``store``).
     """
     p = parameter_tuple(p_vec)
     n = ax.shape[0]
@@ -537,17 +543,15 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     g0 = np.zeros(N_EVENTS)
     f_end = np.zeros(N_STATE)
     fsal = False  # stages[0] holds f(y) in the current mode
-    resp = np.zeros((2, N_SOLVE_OUT))
-    order = np.zeros(27, dtype=np.int64)
+    # response vectors of the non-rocking modes, solved once per run (see nonrocking_span)
+    resp = np.zeros((9, 2, N_SOLVE_OUT))
+    resp_state = np.zeros(9, dtype=np.int64)
     peaks = np.zeros(2)
     g1 = np.zeros(N_EVENTS)
     gw = np.zeros(N_EVENTS)
     armed = np.ones(N_EVENTS, dtype=np.bool_)
     ms = np.zeros(6, dtype=np.int64)
-    ev_t = np.empty(16)
-    ev_k = np.empty(16, dtype=np.int64)
-    ev_f = np.empty(16, dtype=np.int64)
-    ev_to = np.empty(16, dtype=np.int64)
+    log_size = ev_t.shape[0] if store else 0
     n_ev = 0
     for i in range(N_SUMMARY):
         summary[i] = 0.0
@@ -566,17 +570,17 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
         y[i] = y_init[i]
     k = 0
     tau = 0.0
-    status = select_mode(p, y, ms, 0, 0.0, dt, ax, ay, has_ay, sh, sv, -1, w7, order)
+    status = select_mode(p, y, ms, 0, 0.0, dt, ax, ay, has_ay, sh, sv, -1, w7)
     if status == 2:
         failure = Failure.SEPARATION
         failure_time = 0.0
     elif status == 1:
         n_fallback += 1
-    if store:
+    if log_size > 0:
         ev_t[0] = 0.0
-        ev_k[0] = EventKind.SEPARATION if failure else EventKind.START
-        ev_f[0] = 0
-        ev_to[0] = 0 if failure else mode_number(ms)
+        ev_kft[0, 0] = EventKind.SEPARATION if failure else EventKind.START
+        ev_kft[1, 0] = 0
+        ev_kft[2, 0] = 0 if failure else mode_number(ms)
     n_ev = 1
     if ms[MS_ROCK]:
         uplift = 1
@@ -593,7 +597,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
             k_before = k
             k, tau, best_e = nonrocking_span(
                 p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary, peaks, store,
-                hist, modes, resp, gw)
+                hist, modes, resp, resp_state, gw)
             peak_xb = peaks[0]
             peak_xs = peaks[1]
             if k != k_before:
@@ -759,8 +763,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
                 kind = EventKind.SEPARATION
             if failure == 0:
                 old0, old1, old2, old3, old4, old5 = ms[0], ms[1], ms[2], ms[3], ms[4], ms[5]
-                status = select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7,
-                                     order)
+                status = select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7)
                 if status == 2:
                     failure = Failure.SEPARATION
                     kind = EventKind.SEPARATION
@@ -779,12 +782,11 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
                         uplift = 1
             if failure != 0:
                 failure_time = t_now
-            if store:
-                ev_t, ev_k, ev_f, ev_to = _grow(ev_t, ev_k, ev_f, ev_to, n_ev)
+            if n_ev < log_size:
                 ev_t[n_ev] = t_now
-                ev_k[n_ev] = kind
-                ev_f[n_ev] = from_mode
-                ev_to[n_ev] = 0 if failure else mode_number(ms)
+                ev_kft[0, n_ev] = kind
+                ev_kft[1, n_ev] = from_mode
+                ev_kft[2, n_ev] = 0 if failure else mode_number(ms)
             n_ev += 1
             events_here += 1
             if events_here > MAX_EVENTS_PER_SAMPLE and failure == 0:
@@ -836,8 +838,6 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     summary[S_ENERGY_FINAL] = kinetic_energy(
         p, y[Y_TH], s_final, ms[MS_ROCK], y[Y_VB], y[Y_OM], y[Y_VS]
     ) + potential_energy(p, y[Y_TH])
-    return ev_t[:n_ev] if store else ev_t[:0], ev_k[:n_ev] if store else ev_k[:0], \
-        ev_f[:n_ev] if store else ev_f[:0], ev_to[:n_ev] if store else ev_to[:0]
 
 
 @njit(cache=True)
@@ -862,6 +862,8 @@ def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params
     n_cases = case_record.shape[0]
     empty_hist = np.zeros((N_HIST, 0))
     empty_modes = np.zeros(0, dtype=np.int64)
+    empty_t = np.zeros(0)
+    empty_kft = np.zeros((3, 0), dtype=np.int64)
     at_rest = np.zeros(N_DYN)
     # a run-time False: a literal would make numba compile ``run`` a second time for it
     store = n_cases < 0
@@ -870,5 +872,5 @@ def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params
         a0 = offsets[r]
         a1 = offsets[r + 1]
         run(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
-            case_sv[c], dts[r], rtol, atol, zeno_omega, store, empty_hist, empty_modes,
-            summaries[c], at_rest)
+            case_sv[c], dts[r], rtol, atol, zeno_omega, store, empty_hist, empty_modes, empty_t,
+            empty_kft, summaries[c], at_rest)

@@ -1,0 +1,117 @@
+"""Shortcuts of the closed-form span and the kernel that must not change a result.
+
+Each shortcut skips work the direct computation would do (a division in the slip screen, the
+sample-by-sample screen of a rest phase, an event log grown while the run goes on); these tests
+check that the shortcut decides or returns exactly what the direct computation does.
+"""
+
+import numpy as np
+import pytest
+
+from shipblock import ShipBlockSystem, simulate, simulate_batch
+from shipblock.equations import solve_mode
+from shipblock.solver._closed_form import REST_BLOCK, rest_breaks, skip_rest, slip_may_stop
+from shipblock.solver._layout import parameter_tuple
+from shipblock.system import P_B, P_G, P_H, P_MUS1, P_MUS2
+
+
+def direct_slip_screen(sig, v0, u0, u1, h):
+    """The screen as the root search sets it up: q(s) = sig v0 + d0 s + c s^2."""
+    c = sig * (u1 - u0) / (2.0 * h)
+    d0 = sig * u0
+    return sig * v0 + h * (d0 + c * h) < 0.0 or (d0 < 0.0 and d0 + 2.0 * c * h > 0.0)
+
+
+def test_slip_screen_without_division_decides_as_the_direct_screen():
+    rng = np.random.default_rng(1)
+    n_suspect = 0
+    for _ in range(40000):
+        sig = float(rng.choice([-1.0, 1.0]))
+        h = 0.01 if rng.random() < 0.5 else 0.01 * 10.0 ** rng.uniform(-12, 0)
+        scale = 10.0 ** rng.uniform(-3, 1)
+        u0, u1 = rng.normal(size=2) * scale
+        if rng.random() < 0.2:
+            u1 = u0 * (1 + rng.normal() * 1e-15)  # no curvature, up to round-off
+        v0 = rng.normal() * scale * h
+        kind = rng.integers(4)
+        if kind == 1:
+            # ends at zero up to a few ulps: the screen's decision rests on round-off
+            q1 = sig * h * (u0 + 0.5 * (u1 - u0))
+            v0 = -sig * q1 * (1 + rng.integers(-4, 5) * 2.0**-52)
+        elif kind == 2:
+            v0 = 0.0  # just started slipping
+        elif kind == 3:
+            # slope turning from negative to positive right at the end
+            u0 = -sig * abs(u0)
+            u1 = u0 * (-1 + rng.integers(-4, 5) * 2.0**-52)
+        want = direct_slip_screen(sig, v0, u0, u1, h)
+        assert slip_may_stop(sig, v0, u0, u1, h) == want, (sig, v0, u0, u1, h)
+        n_suspect += want
+    assert 1000 < n_suspect < 39000  # both outcomes well represented
+
+
+def rest_coefficients(system):
+    """Response vectors of rest (mode 1) as the span takes them."""
+    p = parameter_tuple(system.to_parameter_vector())
+    wa, wg = np.empty(7), np.empty(7)
+    assert solve_mode(p, 0, 0, 0, 1.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0, wa)
+    assert solve_mode(p, 0, 0, 0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, wg)
+    # grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H
+    return (p[P_G], wa[3], wg[3], wa[4], wg[4], wa[5], wg[5], wa[6], wg[6], p[P_MUS1], p[P_MUS2],
+            p[P_B], p[P_H])
+
+
+def span_rest_screen(a1, b1, c):
+    """The span's screen at the end of an interval of rest, every event armed (Python)."""
+    grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H = c
+    G1 = grav + b1
+    fx1, fy1 = fx_a * a1 + fx_g * G1, fy_a * a1 + fy_g * G1
+    Fx1, Fy1 = Fx_a * a1 + Fx_g * G1, Fy_a * a1 + Fy_g * G1
+    return (fy1 <= 0.0 or Fy1 <= 0.0 or B * (fy1 + Fy1) < H * abs(fx1 + Fx1)
+            or mus1 * fy1 < abs(fx1) or mus2 * Fy1 < abs(Fx1))
+
+
+@pytest.mark.parametrize("has_ay", [True, False])
+def test_rest_blocks_skip_exactly_the_passing_samples(has_ay):
+    system = ShipBlockSystem.example()
+    c = rest_coefficients(system)
+    rng = np.random.default_rng(2)
+    n, dt, sh, sv = 3000, 0.005, 1.3, 0.7
+    ax = rng.normal(size=n) * 0.5
+    ay = rng.normal(size=n) * 0.5
+    # sparse samples strong enough to break rest, some of them right at the friction limit
+    for j in rng.choice(n, 25, replace=False):
+        ax[j] = rng.choice([-1, 1]) * (8.0 if rng.random() < 0.5 else 0.6 * 9.80665 / sh)
+    breaks = np.array([span_rest_screen(sh * ax[j], sv * ay[j] if has_ay else 0.0, c)
+                       for j in range(n)])
+    assert breaks.sum() > 10
+    for j in range(n):
+        assert rest_breaks(ax[j], ay[j], has_ay, sh, sv, *c) == breaks[j]
+    for k0 in list(rng.choice(n - 1, 60, replace=False)) + [0, n - REST_BLOCK - 1, n - 2]:
+        k, time = skip_rest(ax, ay, has_ay, sh, sv, int(k0), dt, 0.25, *c)
+        assert k0 <= k <= n - 1
+        assert not breaks[k0 + 1:k + 1].any()  # nothing skipped that the screen would stop at
+        assert k + REST_BLOCK >= n or breaks[k + 1:k + 1 + REST_BLOCK].any()  # stops at a break
+        want = 0.25
+        for _ in range(k - k0):
+            want += dt  # interval by interval, as the span adds it
+        assert time == want
+
+
+def test_event_log_longer_than_the_record():
+    # a rocking block settling through hundreds of impacts in a 6-sample record: the log the
+    # kernel is first given is too short, and the run is made again with room for every event
+    system = ShipBlockSystem(ship_mass=5e6, block_mass=1500.0, n_blocks=150, half_width=0.12,
+                             half_height=0.8, mu_s_ground=0.8, mu_k_ground=0.8, mu_s_ship=0.8,
+                             mu_k_ship=0.8)
+    ax = np.zeros(6)
+    ax[1] = 1.6
+    res = simulate(system, ax, None, 0.5)
+    n_ev = int(res.summary["n_events"])
+    assert n_ev > ax.size + 16
+    assert len(res.events) == n_ev == res.events.time.size
+    assert res.events[0].kind == "start" and res.events[-1].kind == "rocking_stop"
+    assert np.all(np.diff(res.events.time) >= 0.0)
+    assert res.summary["n_impacts"] == sum(e.kind in ("impact", "rocking_stop") for e in res.events)
+    batch = simulate_batch(system, [(ax, None)], 0.5, [[0, 0, 1.0, 1.0]])
+    assert batch["n_events"][0] == n_ev
