@@ -44,6 +44,7 @@ import math
 import numpy as np
 from numba import njit
 
+from shipblock.errors import ParameterError
 from shipblock.modes import MODE_FLAGS
 from shipblock.system import (
     P_B,
@@ -265,7 +266,7 @@ def mode_response(system, mode, theta, theta_dot, ax, ay, s=1, sigma_ground=1, s
         For a mode outside 1..8 or a mode whose equations are singular at this state.
     """
     if int(mode) != mode or not 1 <= mode <= 8:
-        raise ValueError(f"mode must be an integer 1..8, got {mode!r}")
+        raise ParameterError(f"mode must be an integer 1..8, got {mode!r}")
     flags = MODE_FLAGS[int(mode)]
     p = system.to_parameter_vector()
     out = np.empty(N_SOLVE_OUT)
@@ -277,5 +278,5 @@ def mode_response(system, mode, theta, theta_dot, ax, ay, s=1, sigma_ground=1, s
         th, om, float(ax), p[P_G] + float(ay), out,
     )
     if not ok:
-        raise ValueError(f"the equations of mode {mode} are singular at this state")
+        raise ParameterError(f"the equations of mode {mode} are singular at this state")
     return out[:3].copy(), out[3:].copy()

@@ -4,7 +4,7 @@ and they stay ValueErrors for code that expects the conventional type."""
 import numpy as np
 import pytest
 
-from shipblock import ShipBlockSystem, intensity, scaling
+from shipblock import ShipBlockSystem, intensity, scaling, simulate, simulate_batch
 from shipblock.errors import ParameterError, RecordError, ShipblockError
 from shipblock.fragility.design import AnalysisDesign, IntensityDesign
 from shipblock.fragility.fit import fit_mle
@@ -30,6 +30,13 @@ CASES = {
                                             ShipBlockSystem.example()).validate(), "records"),
     "counts above totals": (lambda: fit_mle([1.0, 2.0], [3, 1], [2, 2]), "n_exceed"),
     "unknown EDP": (lambda: LimitState("x", "ship_slipp", 0.1).validate(), "ship_slipp"),
+    "simulate dt": (lambda: simulate(ShipBlockSystem.example(), ACC, None, -0.01), "dt"),
+    "simulate NaN": (lambda: simulate(ShipBlockSystem.example(), np.r_[ACC, np.nan], None, 0.01),
+                     "non-finite"),
+    "simulate H/V lengths": (lambda: simulate(ShipBlockSystem.example(), ACC, ACC[:-1], 0.01),
+                             "same length"),
+    "batch case index": (lambda: simulate_batch([ShipBlockSystem.example()], [(ACC, None)], 0.01,
+                                                [[1, 0, 1.0, 1.0]]), "record index"),
 }
 
 

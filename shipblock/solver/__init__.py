@@ -14,6 +14,7 @@ from collections.abc import Sequence
 import numba
 import numpy as np
 
+from shipblock.errors import ParameterError
 from shipblock.result import Energy, EventLog, SimulationResult, failure_name
 from shipblock.solver import _kernel as K
 from shipblock.system import P_THC, ShipBlockSystem
@@ -51,25 +52,25 @@ MODE_TIME_FIELDS = [f"time_in_mode_{m}" for m in range(1, 9)]
 def _as_acceleration(values, name: str) -> np.ndarray:
     arr = np.asarray(values, dtype=float)
     if arr.ndim != 1:
-        raise ValueError(f"{name} must be a one-dimensional array, got shape {arr.shape}")
+        raise ParameterError(f"{name} must be a one-dimensional array, got shape {arr.shape}")
     if arr.size < 2:
-        raise ValueError(f"{name} must have at least 2 samples, got {arr.size}")
+        raise ParameterError(f"{name} must have at least 2 samples, got {arr.size}")
     bad = ~np.isfinite(arr)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{name} has {int(bad.sum())} non-finite samples (first at index {i})")
+        raise ParameterError(f"{name} has {int(bad.sum())} non-finite samples (first at index {i})")
     return np.ascontiguousarray(arr)
 
 
 def _check_options(dt, rtol, atol, zeno_omega):
     if not (isinstance(dt, int | float | np.floating) and math.isfinite(dt) and dt > 0):
-        raise ValueError(f"dt must be a finite number > 0 [s], got {dt!r}")
+        raise ParameterError(f"dt must be a finite number > 0 [s], got {dt!r}")
     if not (0 < rtol < 1):
-        raise ValueError(f"rtol must lie in (0, 1), got {rtol!r}")
+        raise ParameterError(f"rtol must lie in (0, 1), got {rtol!r}")
     if not (atol > 0):
-        raise ValueError(f"atol must be > 0, got {atol!r}")
+        raise ParameterError(f"atol must be > 0, got {atol!r}")
     if not (zeno_omega >= 0):
-        raise ValueError(f"zeno_omega must be >= 0 [rad/s], got {zeno_omega!r}")
+        raise ParameterError(f"zeno_omega must be >= 0 [rad/s], got {zeno_omega!r}")
 
 
 def simulate(
@@ -138,7 +139,7 @@ def simulate(
         motion = ax
         ax, ay, dt = motion.horizontal, motion.vertical, motion.dt
     if dt is None:
-        raise ValueError("dt [s] is required when ax is an array")
+        raise ParameterError("dt [s] is required when ax is an array")
     if not isinstance(system, ShipBlockSystem):
         raise TypeError(f"system must be a ShipBlockSystem, got {type(system).__name__}")
     _check_options(dt, rtol, atol, zeno_omega)
@@ -149,16 +150,16 @@ def simulate(
     else:
         ay_arr = _as_acceleration(ay, "ay")
         if ay_arr.size != ax.size:
-            raise ValueError(f"ax and ay must have the same length, got {ax.size} and {ay_arr.size}")
+            raise ParameterError(f"ax and ay must have the same length, got {ax.size} and {ay_arr.size}")
         has_ay = True
     y_init = np.zeros(6)
     if initial_state is not None:
         y_init = np.asarray(initial_state, dtype=float)
         if y_init.shape != (6,) or not np.isfinite(y_init).all():
-            raise ValueError("initial_state must be 6 finite numbers (x_b, theta, x_s, v_b, "
+            raise ParameterError("initial_state must be 6 finite numbers (x_b, theta, x_s, v_b, "
                              f"theta_dot, v_s), got {initial_state!r}")
         if abs(y_init[1]) >= system.critical_angle:
-            raise ValueError(f"initial_state theta={y_init[1]} is beyond the critical angle "
+            raise ParameterError(f"initial_state theta={y_init[1]} is beyond the critical angle "
                              f"{system.critical_angle:.6g} rad")
     p = system.to_parameter_vector()
     n = ax.size
@@ -271,12 +272,12 @@ def simulate_batch(
         dts = [dts] * n_rec
     dts_arr = np.asarray(dts, dtype=float)
     if dts_arr.shape != (n_rec,):
-        raise ValueError(f"dts must give one sample interval per record ({n_rec})")
+        raise ParameterError(f"dts must give one sample interval per record ({n_rec})")
     for i, d in enumerate(dts_arr):
         try:
             _check_options(float(d), rtol, atol, zeno_omega)
         except ValueError as exc:
-            raise ValueError(f"record {i}: {exc}") from None
+            raise ParameterError(f"record {i}: {exc}") from None
     hs, vs, has_v = [], [], []
     for i, (h, v) in enumerate(records):
         h = _as_acceleration(h, f"records[{i}] horizontal")
@@ -287,20 +288,20 @@ def simulate_batch(
         else:
             v = _as_acceleration(v, f"records[{i}] vertical")
             if v.size != h.size:
-                raise ValueError(f"records[{i}]: horizontal and vertical lengths differ")
+                raise ParameterError(f"records[{i}]: horizontal and vertical lengths differ")
             vs.append(v)
             has_v.append(True)
     offsets = np.zeros(n_rec + 1, dtype=np.int64)
     offsets[1:] = np.cumsum([h.size for h in hs])
     cases = np.asarray(cases, dtype=float)
     if cases.ndim != 2 or cases.shape[1] != 4:
-        raise ValueError("cases must have shape (n_cases, 4): record, system, scale_h, scale_v")
+        raise ParameterError("cases must have shape (n_cases, 4): record, system, scale_h, scale_v")
     rec_idx = cases[:, 0].astype(np.int64)
     par_idx = cases[:, 1].astype(np.int64)
     if rec_idx.min(initial=0) < 0 or rec_idx.max(initial=0) >= n_rec:
-        raise ValueError("a case refers to a record index out of range")
+        raise ParameterError("a case refers to a record index out of range")
     if par_idx.min(initial=0) < 0 or par_idx.max(initial=0) >= len(params):
-        raise ValueError("a case refers to a system index out of range")
+        raise ParameterError("a case refers to a system index out of range")
     # numba splits the case range into one contiguous block per thread; dealing the cases out
     # round-robin first keeps the blocks alike when costs trend along the list (rising scale
     # factors in an IDA, heavier records at the end), so no thread is left with the heavy end
