@@ -206,3 +206,20 @@ def test_selectors_skip_runs_outside_a_stripe(tmp_path):
         case_number(design, {"record": "S2", "im_level_g": 0.3})
     with pytest.raises(SelectionError, match="in no stripe"):
         select_cases(design, {"record": "S0", "im_level_g": 0.6})
+
+
+def test_histories_of_a_dask_batch_equal_the_local_ones(history_run, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    tmp, path, local = history_run
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        remote = run_pipeline(path, output=tmp_path / "dask.nc", client=client, progress=False)
+    np.testing.assert_array_equal(remote["history_file"].values,
+                                  np.char.replace(local["history_file"].values.astype(str),
+                                                  "result_histories", "dask_histories"))
+    for name in local["history_file"].values.ravel():
+        if name:
+            with xr.open_dataset(tmp / "out" / name) as a, \
+                    xr.open_dataset(tmp_path / name.replace("result_", "dask_")) as b:
+                xr.testing.assert_identical(a.drop_attrs(deep=False), b.drop_attrs(deep=False))
