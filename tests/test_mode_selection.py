@@ -10,7 +10,7 @@ from shipblock import ShipBlockSystem
 from shipblock.equations import mode_response
 from shipblock.modes import MODE_NUMBER
 from shipblock.solver import _kernel as K
-from shipblock.solver._layout import ACC_TOL, FORCE_TOL, parameter_tuple
+from shipblock.solver._layout import ACC_TOL, FORCE_TOL
 
 
 def reference_choice(system, y, a, ay, trigger):
@@ -63,7 +63,7 @@ def test_kernel_choice_equals_exhaustive_ranking(seed):
     system = ShipBlockSystem(ship_mass=4e5, block_mass=1500.0, n_blocks=20, half_width=0.3,
                              half_height=0.8, mu_s_ground=0.35, mu_k_ground=0.3,
                              mu_s_ship=0.3, mu_k_ship=0.25)
-    p = parameter_tuple(system.to_parameter_vector())
+    p = system.to_parameter_vector()  # the kernel passes the array (see select_mode)
     w7 = np.zeros(7)
     ms = np.zeros(6, dtype=np.int64)
     n_checked = 0
@@ -79,10 +79,7 @@ def test_kernel_choice_equals_exhaustive_ranking(seed):
             y[4] = rng.choice([0.4, -0.4])  # just after an impact
         a, ay = rng.normal() * 4.0, rng.normal() * 2.0
         trigger = int(rng.integers(-1, 3))
-        # the kernel evaluates ONE_SIDED_DT after t; a constant record makes that moot
-        ax_rec, ay_rec = np.full(4, a), np.full(4, ay)
-        status = K.select_mode(p, y, ms, 0, 0.0, 0.01, ax_rec, ay_rec, True, 1.0, 1.0, trigger,
-                               w7)
+        status = K.select_mode(p, y, ms, a, ay, trigger, w7)
         want, consistent = reference_choice(system, y, a, ay, trigger)
         if status == 2:
             continue

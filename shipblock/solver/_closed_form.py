@@ -39,6 +39,7 @@ from shipblock.equations import (
     I_SFY,
     I_XB_DD,
     I_XS_DD,
+    N_SOLVE_OUT,
     kinetic_energy,
     solve_mode,
 )
@@ -66,7 +67,12 @@ from shipblock.solver._layout import (
     N_STATE,
     REARM_TOL,
     ROOT_TIME_TOL,
-    S_MODE_TIME,
+    W_G,
+    W_INV_W,
+    W_INV_WR,
+    W_INV_WS,
+    W_RESP,
+    W_RESP_STATE,
     Y_DIS,
     Y_VB,
     Y_VS,
@@ -152,14 +158,14 @@ def slip_may_stop(sig, v0, u0, u1, h):
 
     The test divides by ``2 h`` (the quadratic coefficient, as the root search uses it): a
     division on the way to the screen's branch in every sliding sample. It is made only when
-    the same test without the division (the coefficient times ``h`` taken as
-    ``sig (u1 - u0) / 2``), with a margin far above the round-off between the two, cannot rule
-    the interval out; so the result is the same.
+    the same test without divisions (the coefficient times ``h`` taken as
+    ``sig (u1 - u0) / 2``, the end slope compared times ``h``), with a margin far above the
+    round-off between the two, cannot rule the interval out; so the result is the same.
     """
     d0 = sig * u0
     dd = sig * (u1 - u0)
     margin = 1e-12 * (abs(v0) + h * (abs(u0) + abs(u1)))
-    if sig * v0 + h * (d0 + 0.5 * dd) >= margin and (d0 >= 0.0 or d0 + dd <= -margin / h):
+    if sig * v0 + h * (d0 + 0.5 * dd) >= margin and (d0 >= 0.0 or (d0 + dd) * h <= -margin):
         return False
     c = dd / (2.0 * h)
     return sig * v0 + h * (d0 + c * h) < 0.0 or (d0 < 0.0 and d0 + 2.0 * c * h > 0.0)
@@ -295,14 +301,16 @@ def response_slot(slip1, sig1, slip2, sig2):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary, peaks,
-                    store, hist, modes, resp, resp_state, g):
+def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs,
+                    store, hist, modes, work):
     """Advance a non-rocking mode sample by sample until an event or the end of the record.
 
     Parameters
     ----------
-    p : tuple of float
-        Parameters (:func:`~shipblock.solver._layout.parameter_tuple`).
+    p : ndarray
+        Parameter vector (see ``shipblock.system.P_*``). The array rather than the kernel's
+        tuple: numba passes a tuple as its 14 floats, an array as a few machine words, and
+        without reference counting here an array costs nothing else.
     ms, y : ndarray
         Mode state and state (``y`` is updated in place).
     k, tau : int, float
@@ -311,58 +319,62 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
         Record and scale factors as in :func:`shipblock.solver._kernel.run`.
     armed : ndarray of bool
         Events being watched; disarmed ones are re-armed once clear of zero.
-    summary : ndarray
-        Time in the mode is accumulated here.
-    peaks : ndarray, shape (2,)
+    peak_xb, peak_xs : float
         Running peaks of |x_b| and |x_s| at the samples.
     store, hist, modes
         History output, as in ``run``: each sample the span completes is written.
-    resp : ndarray, shape (9, 2, 7)
-        Response vectors ``w_a``, ``w_G`` of the non-rocking modes, one row per
-        :func:`response_slot`; solved on a mode's first span and reused by its later spans in
-        the run (a stick-slip record enters the same few modes thousands of times).
-    resp_state : ndarray of int, shape (9,)
-        Per slot: 0 not solved yet, 1 solved, 2 singular. Zero at the start of a run (the
-        vectors depend on the parameters).
-    g : ndarray, shape (N_EVENTS,)
-        Work array for the event functions.
+    work : ndarray, shape (N_SPAN_WORK,)
+        Per-run work array (layout ``W_*`` in :mod:`~shipblock.solver._layout`), zero at the
+        start of a run: the event functions; per :func:`response_slot` of the non-rocking
+        modes its state (0 not solved yet, 1 solved, 2 singular) and response vectors ``w_a``,
+        ``w_G``, solved on a mode's first span and reused by its later spans in the run (a
+        stick-slip record enters the same few modes thousands of times); the inverse weights
+        that scale the event functions, set by the first span.
 
     Returns
     -------
     k, tau : int, float
-        Where the span stopped: at the event (``y`` is the state there and its time has been
-        counted in the summary), or at the end of the record.
+        Where the span stopped: at the event (``y`` is the state there), or at the end of the
+        record.
     event : int
         The event (``EV_*``), -1 at the end of the record, -2 if the mode is singular.
+    time_in_mode : float
+        Time the span spent in the mode [s], to be added to the summary (0 if singular).
+    peak_xb, peak_xs : float
+        The running peaks, updated.
     """
     n = ax.shape[0]
     slip1, slip2 = ms[MS_SLIP1], ms[MS_SLIP2]
     sig1, sig2 = float(ms[MS_SIG1]), float(ms[MS_SIG2])
     slot = response_slot(slip1, sig1, slip2, sig2)
-    wa = resp[slot, 0]
-    wg = resp[slot, 1]
-    if resp_state[slot] == 0:
+    start = W_RESP + 2 * N_SOLVE_OUT * slot
+    wa = work[start:start + N_SOLVE_OUT]
+    wg = work[start + N_SOLVE_OUT:start + 2 * N_SOLVE_OUT]
+    g = work[W_G:W_G + N_EVENTS]
+    if work[W_RESP_STATE + slot] == 0.0:
         ok_a = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
         ok_g = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)
-        resp_state[slot] = 1 if ok_a and ok_g else 2
-    if resp_state[slot] == 2:
-        return k, tau, -2
+        work[W_RESP_STATE + slot] = 1.0 if ok_a and ok_g else 2.0
+    if work[W_RESP_STATE + slot] == 2.0:
+        return k, tau, -2, 0.0, peak_xb, peak_xs
     ub_a, us_a, fx_a, fy_a, Fx_a, Fy_a = wa[I_XB_DD], wa[I_XS_DD], wa[I_FX], wa[I_FY], wa[I_SFX], wa[I_SFY]
     ub_g, us_g, fx_g, fy_g, Fx_g, Fy_g = wg[I_XB_DD], wg[I_XS_DD], wg[I_FX], wg[I_FY], wg[I_SFX], wg[I_SFY]
     grav = p[P_G]
     mus1, mus2, B, H = p[P_MUS1], p[P_MUS2], p[P_B], p[P_H]
     M = p[P_M]
     mass_b = p[P_NM] + M
-    inv_w = 1.0 / (mass_b * grav)
-    inv_ws = 1.0 / (M * grav)
-    inv_wr = inv_w / p[P_R]
+    if work[W_INV_W] == 0.0:
+        # once per run: divisions that would otherwise be made at every event
+        work[W_INV_W] = 1.0 / (mass_b * grav)
+        work[W_INV_WS] = 1.0 / (M * grav)
+        work[W_INV_WR] = work[W_INV_W] / p[P_R]
+    inv_w, inv_ws, inv_wr = work[W_INV_W], work[W_INV_WS], work[W_INV_WR]
     mode = MODE_NUMBER[slip1, 0, slip2]
-    mode_slot = S_MODE_TIME + mode - 1
     all_armed = True
     for e in range(N_EVENTS):
         if not armed[e]:
             all_armed = False
-    time_in_mode = 0.0  # accumulated here, added to the summary when the span ends
+    time_in_mode = 0.0  # accumulated here, added to the summary by the caller
     if not slip1 and not slip2 and all_armed and y[Y_VB] == 0.0 and y[Y_VS] == 0.0:
         # Rest: nothing moves and an interval passes the screen on the input at its end alone.
         # The first intervals are screened one by one (rest often ends within a few), then
@@ -456,8 +468,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
                 exact_update(y, best_h, ub0, ub0 + (ub1 - ub0) * u, us0, us0 + (us1 - us0) * u,
                              a0, a0 + (a1 - a0) * u, fx0, fx0 + (fx1 - fx0) * u, Fx0,
                              Fx0 + (Fx1 - Fx0) * u, mass_b, M)
-                summary[mode_slot] += time_in_mode + best_h
-                return k, tau + best_h, best_e
+                return k, tau + best_h, best_e, time_in_mode + best_h, peak_xb, peak_xs
         # no event: advance exactly to the next sample
         moving_b = slip1 or vb0 != 0.0
         moving_s = slip2 or vs0 != 0.0
@@ -469,11 +480,11 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
             else:
                 exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M)
             axb = abs(y[Y_XB])
-            if axb > peaks[0]:
-                peaks[0] = axb
+            if axb > peak_xb:
+                peak_xb = axb
             axs = abs(y[Y_XS])
-            if axs > peaks[1]:
-                peaks[1] = axs
+            if axs > peak_xs:
+                peak_xs = axs
         time_in_mode += h
         k += 1
         tau = 0.0
@@ -491,8 +502,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary
                         all_armed = False
         if store:
             _store(p, y, hist, modes, k, mode)
-    summary[mode_slot] += time_in_mode
-    return k, tau, -1
+    return k, tau, -1, time_in_mode, peak_xb, peak_xs
 
 
 @njit(cache=True, error_model="numpy")

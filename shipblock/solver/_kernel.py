@@ -75,6 +75,7 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     N_DYN,
     N_EVENTS,
     N_HIST,
+    N_SPAN_WORK,
     N_STATE,
     N_SUMMARY,
     ONE_SIDED_DT,
@@ -415,7 +416,7 @@ CANDIDATE_KEYS, CANDIDATE_COUNTS = _candidate_order()
 
 
 @njit(cache=True, _nrt=False)
-def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
+def select_mode(p, y, ms, a, b, trigger, w7):
     """Choose the next mode among the candidates consistent with the velocities.
 
     Candidates: an interface with a nonzero slip velocity keeps slipping that way; one at zero
@@ -433,13 +434,30 @@ def select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7):
     the choice and the search stops there: after most events one or two candidates are solved
     instead of up to 27.
 
+    Parameters
+    ----------
+    p : ndarray
+        Parameter vector (an array, as for
+        :func:`~shipblock.solver._closed_form.nonrocking_span`).
+    y : ndarray
+        State at the event.
+    ms : ndarray of int
+        Receives the chosen mode state.
+    a, b : float
+        Scaled horizontal and vertical ground acceleration ONE_SIDED_DT after the event
+        [m/s^2] (taken by the caller, so that the record need not be passed: numba passes each
+        array argument as several machine words, and this runs at every event).
+    trigger : int
+        Interface whose event this is: 0 ground, 1 rocking, 2 ship, -1 none.
+    w7 : ndarray, shape (N_SOLVE_OUT,)
+        Work array for :func:`~shipblock.equations.solve_mode`.
+
     Returns
     -------
     status : int
         0 a consistent mode was chosen, 1 none was consistent and the least-violating was
         taken, 2 every candidate had a non-positive normal force (separation).
     """
-    a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + ONE_SIDED_DT, dt)
     G = p[P_G] + b
     if G <= 0.0:
         return 2  # the ground falls at least as fast as gravity: nothing presses the bodies together
@@ -503,7 +521,8 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     ----------
     p_vec : ndarray
         Parameter vector (used as a tuple inside: a tuple is passed by value, with no
-        reference count for parallel runs to contend on).
+        reference count for parallel runs to contend on; the functions compiled without
+        reference counting, called at every event, take the array, which is cheaper to pass).
     ax, ay : ndarray
         Horizontal and vertical ground acceleration at the samples [m/s^2] (``ay`` ignored
         unless ``has_ay``).
@@ -543,10 +562,9 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     g0 = np.zeros(N_EVENTS)
     f_end = np.zeros(N_STATE)
     fsal = False  # stages[0] holds f(y) in the current mode
-    # response vectors of the non-rocking modes, solved once per run (see nonrocking_span)
-    resp = np.zeros((9, 2, N_SOLVE_OUT))
-    resp_state = np.zeros(9, dtype=np.int64)
-    peaks = np.zeros(2)
+    # the closed-form spans' work array: response vectors of the non-rocking modes, solved
+    # once per run, and the like (see nonrocking_span)
+    span_work = np.zeros(N_SPAN_WORK)
     g1 = np.zeros(N_EVENTS)
     gw = np.zeros(N_EVENTS)
     armed = np.ones(N_EVENTS, dtype=np.bool_)
@@ -570,7 +588,8 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
         y[i] = y_init[i]
     k = 0
     tau = 0.0
-    status = select_mode(p, y, ms, 0, 0.0, dt, ax, ay, has_ay, sh, sv, -1, w7)
+    a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, 0, ONE_SIDED_DT, dt)
+    status = select_mode(p_vec, y, ms, a_next, b_next, -1, w7)
     if status == 2:
         failure = Failure.SEPARATION
         failure_time = 0.0
@@ -592,14 +611,12 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     while k < n - 1 and failure == 0:
         if ms[MS_ROCK] == 0:
             # rest and sliding: closed form, sample by sample, up to the next event
-            peaks[0] = peak_xb
-            peaks[1] = peak_xs
             k_before = k
-            k, tau, best_e = nonrocking_span(
-                p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, summary, peaks, store,
-                hist, modes, resp, resp_state, gw)
-            peak_xb = peaks[0]
-            peak_xs = peaks[1]
+            k, tau, best_e, span_time, peak_xb, peak_xs = nonrocking_span(
+                p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs, store,
+                hist, modes, span_work)
+            if best_e != -2:
+                summary[S_MODE_TIME + mode_number(ms) - 1] += span_time
             if k != k_before:
                 events_here = 0
             if best_e == -1:
@@ -763,7 +780,9 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
                 kind = EventKind.SEPARATION
             if failure == 0:
                 old0, old1, old2, old3, old4, old5 = ms[0], ms[1], ms[2], ms[3], ms[4], ms[5]
-                status = select_mode(p, y, ms, k, tau, dt, ax, ay, has_ay, sh, sv, trigger, w7)
+                a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + ONE_SIDED_DT,
+                                                  dt)
+                status = select_mode(p_vec, y, ms, a_next, b_next, trigger, w7)
                 if status == 2:
                     failure = Failure.SEPARATION
                     kind = EventKind.SEPARATION

@@ -7,6 +7,8 @@ Shared by the compiled kernels (:mod:`shipblock.solver._kernel` and
 import numpy as np
 from numba import njit
 
+from shipblock.equations import N_SOLVE_OUT
+
 # State vector.
 Y_XB, Y_TH, Y_XS, Y_VB, Y_OM, Y_VS, Y_WIN, Y_DIS, Y_IMP = 0, 1, 2, 3, 4, 5, 6, 7, 8
 N_STATE = 9  # the last three accumulate input work, friction dissipation and impact loss [J]
@@ -57,6 +59,20 @@ S_N_FALLBACK = 22
 S_ENERGY_FINAL = 23  # T + V at the end
 S_PEAK_TH_TIME = 24
 N_SUMMARY = 25
+
+# Work array of the closed-form spans (one per run, see ``nonrocking_span``): the event
+# functions, then per response slot its state (0 not solved, 1 solved, 2 singular) and its two
+# response vectors, then the inverse weights (0 until the first span sets them). One array
+# rather than several: the span is called at every event, and numba passes each array argument
+# as several machine words.
+N_RESP_SLOTS = 9  # 3 ground x 3 ship interface states
+W_G = 0
+W_RESP_STATE = W_G + N_EVENTS
+W_RESP = W_RESP_STATE + N_RESP_SLOTS
+W_INV_W = W_RESP + 2 * N_SOLVE_OUT * N_RESP_SLOTS  # 1 / weight
+W_INV_WS = W_INV_W + 1  # 1 / ship weight
+W_INV_WR = W_INV_W + 2  # 1 / (weight R)
+N_SPAN_WORK = W_INV_W + 3
 
 # Numerical constants (documented in docs/theory/solver.md).
 ROOT_TIME_TOL = 1e-12  # [s] width of the bracket that locates an event
