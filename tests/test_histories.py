@@ -16,7 +16,7 @@ from shipblock.fragility.histories import SelectionError, case_number, select_ca
 from shipblock.fragility.pipeline import PipelineError, load_pipeline, rerun_case, run_pipeline
 from shipblock.units import STANDARD_GRAVITY as G
 
-from .test_pipeline import write_pipeline
+from .test_pipeline import local_dask_client, write_pipeline
 
 #: Summary values compared bit for bit between a history file and its batch run.
 COMPARED = ("peak_ship_slip", "peak_block_slip", "peak_rotation", "residual_ship_slip",
@@ -209,11 +209,8 @@ def test_selectors_skip_runs_outside_a_stripe(tmp_path):
 
 
 def test_histories_of_a_dask_batch_equal_the_local_ones(history_run, tmp_path):
-    distributed = pytest.importorskip("distributed")
     tmp, path, local = history_run
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster, \
-            distributed.Client(cluster) as client:
+    with local_dask_client(n_workers=1, processes=False) as client:
         remote = run_pipeline(path, output=tmp_path / "dask.nc", client=client, progress=False)
     np.testing.assert_array_equal(remote["history_file"].values,
                                   np.char.replace(local["history_file"].values.astype(str),

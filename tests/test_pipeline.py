@@ -6,6 +6,7 @@ so that the whole module runs in seconds once the solver is compiled.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -425,11 +426,18 @@ def test_partial_of_another_run_is_refused(tmp_path):
 # -------------------------------------------------------------------------------------------
 
 
-def test_dask_equals_local(ida_run, tmp_path):
+@contextlib.contextmanager
+def local_dask_client(n_workers=2, processes=True):
+    """A Dask client on a LocalCluster of single-threaded workers (skips without distributed)."""
     distributed = pytest.importorskip("distributed")
-    tmp, path, local = ida_run
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster, \
+    with distributed.LocalCluster(n_workers=n_workers, threads_per_worker=1,
+                                  processes=processes, dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
+        yield client
+
+
+def test_dask_equals_local(ida_run, tmp_path):
+    tmp, path, local = ida_run
+    with local_dask_client() as client:
         remote = run_pipeline(path, output=tmp_path / "dask.nc", client=client, progress=False)
     assert_same_results(local, remote)
