@@ -31,7 +31,6 @@ swept together (the width follows the height).
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
@@ -455,14 +454,33 @@ class AnalysisDesign:
         ValueError
             If a combination gives an invalid system (names the combination).
         """
-        out = []
-        for combo in itertools.product(*(values for _, values in self.sweep)):
-            values = dict(zip(self.sweep_names, combo, strict=True))
-            try:
-                out.append(apply_parameters(self.system, values))
-            except ValueError as exc:
-                raise ParameterError(f"sweep {values}: {exc}") from None
-        return out
+        return [self.system_at(i) for i in range(self.n_systems)]
+
+    def system_at(self, index: int) -> ShipBlockSystem:
+        """The swept system of one system index (C order over the sweep dimensions).
+
+        Parameters
+        ----------
+        index : int
+            In ``[0, n_systems)``, as in the third column of :meth:`case_indices`.
+
+        Returns
+        -------
+        ShipBlockSystem
+
+        Raises
+        ------
+        ParameterError
+            If the combination gives an invalid system (names the combination).
+        """
+        if not self.sweep:
+            return self.system
+        combo = np.unravel_index(int(index), self.sweep_shape)
+        values = {name: vals[int(i)] for (name, vals), i in zip(self.sweep, combo, strict=True)}
+        try:
+            return apply_parameters(self.system, values)
+        except ValueError as exc:
+            raise ParameterError(f"sweep {values}: {exc}") from None
 
     def case_indices(self, cases) -> np.ndarray:
         """Grid indices of case numbers.

@@ -255,7 +255,7 @@ def run_case(design: AnalysisDesign, records, case: int, solver_options: Mapping
     # the same input arrays as run_chunk builds
     f_v = fv[j]
     vertical = None if v is None or not np.isfinite(f_v) or f_v == 0.0 else f_v * v
-    system = design.systems()[s]
+    system = design.system_at(s)
     return simulate(system, fh[j] * h, vertical, dt, **dict(solver_options or {}))
 
 

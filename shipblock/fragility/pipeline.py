@@ -87,6 +87,7 @@ import itertools
 import json
 import logging
 import math
+import os
 import time
 import tomllib
 import warnings
@@ -1082,8 +1083,6 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
 def _add_histories(ds, pipe: Pipeline, records, out_path: Path, fingerprint: str,
                    progress: bool) -> xr.Dataset:
     """Write the requested time histories and list them in ``ds["history_file"]``."""
-    import os
-
     design = pipe.design
     request = pipe.histories
     directory = request.directory or out_path.with_name(out_path.stem + "_histories")
