@@ -373,6 +373,27 @@ def test_batch_entry_point_equals_single_runs():
             assert out[key][c] == single.summary[key], (c, key)
 
 
+
+def test_missing_vertical_equals_zero_vertical():
+    """Without a vertical component the kernels get the horizontal as a stand-in they must never
+    read: results equal those with an explicit vertical of zeros, and the result reports zeros."""
+    from shipblock import simulate_batch
+
+    a, _, dt = random_record(5, n=1500)
+    system = all_modes_system()
+    none = simulate(system, a, None, dt)
+    zero = simulate(system, a, np.zeros_like(a), dt)
+    np.testing.assert_array_equal(none.theta, zero.theta)
+    np.testing.assert_array_equal(none.x_s, zero.x_s)
+    np.testing.assert_array_equal(none.mode, zero.mode)
+    np.testing.assert_equal(none.summary, zero.summary)  # NaN where a peak never occurred
+    assert not none.ground_acceleration[1].any()
+    cases = [(0, 0, 1.0, 1.0), (0, 0, 0.6, 1.0)]
+    without = simulate_batch(system, [(a, None)], dt, cases)
+    with_zero = simulate_batch(system, [(a, np.zeros_like(a))], dt, cases)
+    for key, values in without.items():
+        np.testing.assert_array_equal(values, with_zero[key], err_msg=key)
+
 @pytest.mark.parametrize("ship_mass,n", [(1e-6, 1), (2e4, 4)])
 def test_peak_rotation_and_its_time_from_energy(ship_mass, n):
     """Launched from theta = 0 with theta_dot = w0 and no ground motion, the block rises to

@@ -145,7 +145,7 @@ def simulate(
     _check_options(dt, rtol, atol, zeno_omega)
     ax = _as_acceleration(ax, "ax")
     if ay is None:
-        ay_arr = np.zeros_like(ax)
+        ay_arr = ax  # a stand-in the kernel never reads (has_ay False): no zeros to allocate
         has_ay = False
     else:
         ay_arr = _as_acceleration(ay, "ay")
@@ -217,7 +217,7 @@ def simulate(
         energy=energy,
         summary=summ,
         system=system,
-        ground_acceleration=(ax.copy(), ay_arr.copy()),
+        ground_acceleration=(ax.copy(), ay_arr.copy() if has_ay else np.zeros(n)),
         options={"rtol": rtol, "atol": atol, "zeno_omega": zeno_omega},
     )
 
@@ -283,7 +283,7 @@ def simulate_batch(
         h = _as_acceleration(h, f"records[{i}] horizontal")
         hs.append(h)
         if v is None:
-            vs.append(np.zeros_like(h))
+            vs.append(h)  # a stand-in the kernel never reads (has_v False)
             has_v.append(False)
         else:
             v = _as_acceleration(v, f"records[{i}] vertical")
@@ -308,10 +308,14 @@ def simulate_batch(
     n_threads = numba.get_num_threads()
     order = np.argsort(np.arange(cases.shape[0]) % n_threads, kind="stable")
     dealt = np.empty((cases.shape[0], K.N_SUMMARY))
+    acc_h = np.concatenate(hs)
+    # without any vertical component the horizontal stands in (never read): a second array of
+    # the records' size costs page faults out of proportion to a batch of short records
+    acc_v = np.concatenate(vs) if any(has_v) else acc_h
     K.run_many(
         params,
-        np.concatenate(hs),
-        np.concatenate(vs),
+        acc_h,
+        acc_v,
         offsets,
         dts_arr,
         np.array(has_v),

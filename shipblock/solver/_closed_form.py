@@ -394,8 +394,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
                                         fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B,
                                         H)
             if store:
-                for j in range(k_first + 1, k + 1):
-                    _store(p, y, hist, modes, j, mode)
+                _store_rest(p, y, hist, modes, k_first + 1, k + 1, mode)
     a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # start of the interval
     G0 = grav + b0
     fx0 = fx_a * a0 + fx_g * G0
@@ -505,7 +504,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
     return k, tau, -1, time_in_mode, peak_xb, peak_xs
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _store(p, y, hist, modes, k, mode):
     """History column of a non-rocking sample (theta = 0): the state, its energies and mode."""
     for i in range(N_STATE):
@@ -513,3 +512,21 @@ def _store(p, y, hist, modes, k, mode):
     hist[H_KIN, k] = kinetic_energy(p, 0.0, 1.0, 0, y[Y_VB], 0.0, y[Y_VS])
     hist[H_POT, k] = 0.0  # theta = 0: the potential energy's reference
     modes[k] = mode
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _store_rest(p, y, hist, modes, k0, k1, mode):
+    """History columns ``k0:k1`` of a rest phase: the same column repeated, row by row.
+
+    Filling each row over the whole range (contiguous, vectorised) rather than column by
+    column makes storing a skipped rest block about as cheap as skipping it.
+    """
+    kin = kinetic_energy(p, 0.0, 1.0, 0, y[Y_VB], 0.0, y[Y_VS])
+    for i in range(N_STATE):
+        v = y[i]
+        for j in range(k0, k1):
+            hist[i, j] = v
+    for j in range(k0, k1):
+        hist[H_KIN, j] = kin
+        hist[H_POT, j] = 0.0
+        modes[j] = mode
