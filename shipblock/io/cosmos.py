@@ -18,8 +18,17 @@ Header entries used (1-based, as numbered in the specification): Int(1) processi
 kind of quantity (1 = acceleration), Int(3) physical-units code (Table 2), Int(40), Int(42)-Int(45)
 start year, month, day, hour, minute, Int(54) sensor orientation (0-360 deg azimuth, 400 up, 401
 down, 402 vertical of unknown sense, 500/501 radial/transverse, 600/601 longitudinal/tangential,
-700/701 horizontal of unknown azimuth), Real(1)-Real(3) station latitude, longitude [deg] and
-elevation [m], Real(30) start second [s], Real(62) sampling interval [ms].
+700/701 horizontal of unknown azimuth), Int(55) orientation relative to the structure (used only
+to tell vertical from horizontal when Int(54) is unknown), Real(1)-Real(3) station latitude,
+longitude [deg] and elevation [m], Real(30) start second [s], Real(62) sampling interval [ms].
+
+The channel and location codes come from a ``|<SCNL>STA.CHA.NET.LOC`` comment when the file has one
+(the USGS NSMP and CESMD write it; ``--`` is the empty location), else the channel is ``HN`` plus
+the orientation letter of Int(54). Real files can contradict themselves: the USGS copy of AK.BMR
+``BNZ`` (2018 Anchorage) has Int(54)=0 (north) on a vertical channel whose text header says
+"Other". When the SCNL channel's orientation (Z vs horizontal) contradicts Int(54), the reader
+warns and keeps the channel code, dropping the Int(54) azimuth/dip, so a vertical record is never
+silently taken as a horizontal one.
 
 Only the acceleration sections are read. Their unit code (from the data line, checked against
 Int(3)) is honoured: the samples are converted to m/s^2, ``stats.units`` is ``"m/s**2"`` and
@@ -97,6 +106,10 @@ _DATA_HEADER = re.compile(
 )
 _DATA_UNITS = re.compile(r"units\s*=\s*([^(,]*?)\s*\(\s*(\d+)\s*\)", re.IGNORECASE)
 _STATION_CODE = re.compile(r"Code\s*:\s*([A-Za-z0-9]{1,2})\s*-\s*([A-Za-z0-9]+)")
+#: USGS/CESMD comment naming the SEED channel: ``|<SCNL>8040.HNZ.NP.03`` (station.channel.net.loc).
+_SCNL = re.compile(
+    r"<SCNL>\s*([A-Za-z0-9]+)\.([A-Za-z0-9]{3})\.([A-Za-z0-9]{1,2})\.([A-Za-z0-9]{2}|--)?"
+)
 _NULLS = re.compile(r"unknown.*?(-?\d+)\s*,\s*(-?\d+\.?\d*)", re.IGNORECASE)
 
 
@@ -215,6 +228,16 @@ def _orientation(code, null_note: list) -> tuple[dict, str]:
     return {}, "X"
 
 
+def _scnl(comments) -> tuple[str, str, str, str] | None:
+    """Return ``(station, channel, network, location)`` from a ``<SCNL>`` comment, if any."""
+    for line in comments:
+        if (m := _SCNL.search(line)) is not None:
+            station, channel, network, location = m.groups()
+            location = "" if location in (None, "--") else location
+            return station, channel.upper(), network.upper(), location
+    return None
+
+
 def _data_units(data_line: str, int_code, name: str) -> tuple[int, str]:
     """Return the unit code of a data section, cross-checked with Int(3)."""
     match = _DATA_UNITS.search(data_line)
@@ -306,9 +329,31 @@ def _make_trace(name, text, ints, reals, comments, nulls, data_line, code, unit_
         raise RecordError(name, "the sampling interval Real(62) is unknown")
     delta = check_delta(delta_ms / 1000.0, name)
     notes: list[str] = []
-    orientation, letter = _orientation(_value(ints, 54, int_null), notes)
+    sensor, source = _value(ints, 54, int_null), "Int(54)"
+    relative = _value(ints, 55, int_null)
+    if sensor is None and relative is not None:
+        # USGS NSMP structure arrays (e.g. NP.8040) leave Int(54) unknown and give the orientation
+        # relative to the structure in Int(55): enough to tell vertical from horizontal, not the
+        # azimuth (700 = horizontal of unknown azimuth).
+        sensor, source = (relative if int(relative) in (400, 401, 402) else 700), "Int(55)"
+    orientation, letter = _orientation(sensor, notes)
     for note in notes:
         warnings.warn(f"{name}: {note}", stacklevel=4)
+    channel, location = "HN" + letter, ""
+    scnl = _scnl(comments)
+    if scnl is not None:
+        channel, location = scnl[1], scnl[3]
+        vertical_by_code = channel[-1] == "Z"
+        if letter != "X" and (letter == "Z") != vertical_by_code:
+            kinds = ("horizontal", "vertical")
+            note = (
+                f"{source}={int(sensor)} says {kinds[letter == 'Z']} but the <SCNL> channel code"
+                f" {channel} says {kinds[vertical_by_code]}; {source} ignored, orientation taken"
+                " from the channel code"
+            )
+            notes.append(note)
+            warnings.warn(f"{name}: {note}", stacklevel=4)
+            orientation = {}
     station_match = _STATION_CODE.search(text[4]) if len(text) > 4 else None
     start = _start_time(ints, reals, int_null)
     unit_name, factor = UNIT_CODES[code]
@@ -323,6 +368,7 @@ def _make_trace(name, text, ints, reals, comments, nulls, data_line, code, unit_
             "unit_text": unit_text,
             "processing_stage": _value(ints, 1, int_null),
             "orientation_code": _value(ints, 54, int_null),
+            "scnl": scnl,
             "notes": notes,
             "start_time_known": start is not None,
         }
@@ -330,7 +376,8 @@ def _make_trace(name, text, ints, reals, comments, nulls, data_line, code, unit_
     stats = {
         "network": station_match.group(1).upper() if station_match else "",
         "station": station_match.group(2) if station_match else "",
-        "channel": "HN" + letter,
+        "location": location,
+        "channel": channel,
         "units": "counts" if factor is None else "m/s**2",
         "original_units": unit_name,
         "shipblock_cosmos": header,
