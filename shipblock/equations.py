@@ -79,7 +79,9 @@ def pivot_geometry(p, theta, s, rock):
     return p[P_H] / p[P_R], p[P_B] / p[P_R]
 
 
-@njit(cache=True)
+# without reference counting (it neither allocates nor returns arrays): the counts of ``out``
+# would otherwise be updated, atomically, at every evaluation of the equations
+@njit(cache=True, _nrt=False)
 def solve_mode(p, slip1, rock, slip2, s, sig1, sig2, theta, omega, a, G, out):
     """Accelerations and interface forces in the mode given by three interface flags.
 
@@ -104,10 +106,20 @@ def solve_mode(p, slip1, rock, slip2, s, sig1, sig2, theta, omega, a, G, out):
     bool
         False when the 3x3 system is singular (no unique motion in that mode).
     """
+    c, sn = pivot_geometry(p, theta, s, rock)
+    return solve_mode_at(p, slip1, rock, slip2, s, sig1, sig2, c, sn, omega, a, G, out)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def solve_mode_at(p, slip1, rock, slip2, s, sig1, sig2, c, sn, omega, a, G, out):
+    """:func:`solve_mode` with the pivot geometry ``(c, sn)`` of :func:`pivot_geometry` given.
+
+    For callers that need the geometry for more than the equations (the rocking right-hand
+    side also takes the input power), so that its cosine and sine are taken once.
+    """
     M = p[P_M]
     nm = p[P_NM]
     R = p[P_R]
-    c, sn = pivot_geometry(p, theta, s, rock)
     w2 = omega * omega
     Rc = R * c
     Rss = R * s * sn
@@ -124,6 +136,28 @@ def solve_mode(p, slip1, rock, slip2, s, sig1, sig2, theta, omega, a, G, out):
     fxs = M
     fy0 = nm * (G - Rc * w2) + Fy0
     fyt = nm * Rss + Fyt
+    if rock and not slip1 and not slip2:
+        # Rocking on two stuck interfaces, the common rocking mode: rows 0 and 2 below are
+        # unit rows, and Cramer's rule reduces to u1 = b1 / a11 with the same singularity test
+        # (det = a11, scale = the largest entry of row 1). The terms skipped are products with
+        # exact zeros, so the results equal those of the general solve.
+        a10 = -Rc * (fxb + Fxb)
+        a11 = p[P_NI] - Rc * (fxt + Fxt) + Rss * (fyt + Fyt)
+        a12 = -Rc * (fxs + Fxs)
+        b1 = Rc * (fx0 + Fx0) - Rss * (fy0 + Fy0)
+        if not abs(a11) > SINGULAR_RELATIVE * max(abs(a10), abs(a11), abs(a12)):
+            for i in range(N_SOLVE_OUT):
+                out[i] = np.nan
+            return False
+        u1 = b1 / a11
+        out[I_XB_DD] = 0.0
+        out[I_TH_DD] = u1
+        out[I_XS_DD] = 0.0
+        out[I_FX] = fx0 + fxt * u1
+        out[I_FY] = fy0 + fyt * u1
+        out[I_SFX] = Fx0 + Fxt * u1
+        out[I_SFY] = Fy0 + Fyt * u1
+        return True
     # Row 0: ground interface.
     if slip1:
         mu = sig1 * p[P_MUK1]
@@ -154,7 +188,8 @@ def solve_mode(p, slip1, rock, slip2, s, sig1, sig2, theta, omega, a, G, out):
         * max(abs(a20), abs(a21), abs(a22))
     )
     if not abs(det) > SINGULAR_RELATIVE * scale:
-        out[:] = np.nan
+        for i in range(N_SOLVE_OUT):
+            out[i] = np.nan
         return False
     u0 = (b0 * c0 + b1 * (a02 * a21 - a01 * a22) + b2 * (a01 * a12 - a02 * a11)) / det
     u1 = (b0 * c1 + b1 * (a00 * a22 - a02 * a20) + b2 * (a02 * a10 - a00 * a12)) / det
@@ -226,10 +261,16 @@ def input_power(p, theta, s, rock, vb, om, vs, a, ay):
     :math:`P_x = nm(\\dot x_b - Rc\\dot\\theta) + M(\\dot x_b - 2Rc\\dot\\theta + \\dot x_s)` and
     :math:`P_y = (nm+2M)sR\\bar s\\,\\dot\\theta` are the momenta relative to the ground.
     """
+    c, sn = pivot_geometry(p, theta, s, rock)
+    return input_power_at(p, c, sn, s, vb, om, vs, a, ay)
+
+
+@njit(cache=True, inline="always")
+def input_power_at(p, c, sn, s, vb, om, vs, a, ay):
+    """:func:`input_power` with the pivot geometry ``(c, sn)`` of :func:`pivot_geometry` given."""
     M = p[P_M]
     nm = p[P_NM]
     R = p[P_R]
-    c, sn = pivot_geometry(p, theta, s, rock)
     px = nm * (vb - R * c * om) + M * (vb - 2.0 * R * c * om + vs)
     py = (nm + 2.0 * M) * s * R * sn * om
     return -a * px - ay * py

@@ -10,8 +10,9 @@ method on the step length (an impact starting from the root of the step's quinti
 interpolant). The state is advanced to the root, the event is applied, and the next mode is
 chosen among all candidate modes consistent with the velocities by :func:`select_mode`.
 
-Nothing here allocates per step; the kernels take only arrays and scalars. Mode selection, like
-the closed-form span, is compiled without reference counting (see
+Nothing here allocates per step; the kernels take only arrays and scalars. :func:`run` only
+allocates the work arrays: the loop itself (:func:`integrate`), mode selection and the functions
+it calls are compiled without reference counting, like the closed-form span (see
 :mod:`~shipblock.solver._closed_form`).
 """
 
@@ -28,10 +29,12 @@ from shipblock.equations import (
     I_SFX,
     I_SFY,
     N_SOLVE_OUT,
-    input_power,
+    input_power_at,
     kinetic_energy,
+    pivot_geometry,
     potential_energy,
     solve_mode,
+    solve_mode_at,
 )
 from shipblock.impact import apply_impact
 from shipblock.modes import MODE_NUMBER, EventKind, Failure
@@ -118,9 +121,12 @@ from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 def rhs(p, ms, y, a, ay, stages, st, w7):
     """Time derivative of the state in the mode ``ms`` into ``stages[st]``; False if singular."""
     rock = ms[MS_ROCK]
-    ok = solve_mode(
-        p, ms[MS_SLIP1], rock, ms[MS_SLIP2], float(ms[MS_S]), float(ms[MS_SIG1]),
-        float(ms[MS_SIG2]), y[Y_TH], y[Y_OM], a, p[P_G] + ay, w7,
+    s = float(ms[MS_S])
+    # the geometry once for both the equations and the input power (one sine and cosine)
+    c, sn = pivot_geometry(p, y[Y_TH], s, rock)
+    ok = solve_mode_at(
+        p, ms[MS_SLIP1], rock, ms[MS_SLIP2], s, float(ms[MS_SIG1]), float(ms[MS_SIG2]), c, sn,
+        y[Y_OM], a, p[P_G] + ay, w7,
     )
     stages[st, Y_XB] = y[Y_VB]
     stages[st, Y_TH] = y[Y_OM]
@@ -128,9 +134,7 @@ def rhs(p, ms, y, a, ay, stages, st, w7):
     stages[st, Y_VB] = w7[0]
     stages[st, Y_OM] = w7[1]
     stages[st, Y_VS] = w7[2]
-    stages[st, Y_WIN] = input_power(
-        p, y[Y_TH], float(ms[MS_S]), rock, y[Y_VB], y[Y_OM], y[Y_VS], a, ay
-    )
+    stages[st, Y_WIN] = input_power_at(p, c, sn, s, y[Y_VB], y[Y_OM], y[Y_VS], a, ay)
     stages[st, Y_DIS] = -(w7[I_FX] * y[Y_VB] + w7[I_SFX] * y[Y_VS])
     stages[st, Y_IMP] = 0.0
     return ok
@@ -188,7 +192,7 @@ def error_norm(y0, y1, stages, h, rtol, atol):
     return math.sqrt(acc / N_DYN)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g, w7):
     """Fill ``g`` with the event functions at (t_k + tau, y); ``w7`` gets accelerations/forces."""
     a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)
@@ -230,7 +234,7 @@ def has_slope(e):
     return e == EV_G_SLIP or e == EV_S_SLIP or e == EV_IMPACT
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g):
     """Event function ``e`` after advancing ``y0`` by ``h`` (state left in ``y1``).
 
@@ -243,7 +247,7 @@ def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages,
     return g[e]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has_ay, sh, sv,
                 y1, stages, ytmp, w7, g):
     """Illinois iteration for the step length at which event ``e`` crosses zero.
@@ -308,7 +312,7 @@ def mode_number(ms):
     return mode_number_of(ms[MS_SLIP1], ms[MS_ROCK], ms[MS_SLIP2])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def rotation_extremum(y0, y1, al0, al1, h):
     """Peak |theta| inside a rocking step in which theta_dot changes sign, and its time.
 
@@ -549,26 +553,57 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     y_init : ndarray, shape (6,)
         Initial ``(x_b, theta, x_s, v_b, theta_dot, v_s)``.
     """
-    p = parameter_tuple(p_vec)
-    n = ax.shape[0]
-    y = np.zeros(N_STATE)
-    y1 = np.zeros(N_STATE)
-    yr = np.zeros(N_STATE)
-    ytmp = np.zeros(N_STATE)
+    vectors = np.zeros((5, N_STATE))
     stages = np.zeros((7, N_STATE))
-    w7 = np.zeros(N_SOLVE_OUT)
-    w7b = np.zeros(N_SOLVE_OUT)
+    w7 = np.zeros((2, N_SOLVE_OUT))
     K = np.zeros((3, 3))
-    g0 = np.zeros(N_EVENTS)
-    f_end = np.zeros(N_STATE)
-    fsal = False  # stages[0] holds f(y) in the current mode
+    g = np.zeros((3, N_EVENTS))
     # the closed-form spans' work array: response vectors of the non-rocking modes, solved
     # once per run, and the like (see nonrocking_span)
     span_work = np.zeros(N_SPAN_WORK)
-    g1 = np.zeros(N_EVENTS)
-    gw = np.zeros(N_EVENTS)
     armed = np.ones(N_EVENTS, dtype=np.bool_)
     ms = np.zeros(6, dtype=np.int64)
+    integrate(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes,
+              ev_t, ev_kft, summary, y_init, vectors[0], vectors[1], vectors[2], vectors[3],
+              vectors[4], stages, w7[0], w7[1], K, g[0], g[1], g[2], span_work, armed, ms)
+
+
+@njit(cache=True, _nrt=False)
+def integrate(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes,
+              ev_t, ev_kft, summary, y_init, y, y1, yr, ytmp, f_end, stages, w7, w7b, K, g0, g1,
+              gw, span_work, armed, ms):
+    """The integration of :func:`run`, in work arrays allocated there.
+
+    Compiled without reference counting: numba would otherwise update the counts of the work
+    arrays, atomically, around the functions inlined into the loop, which cost about a quarter
+    of a rocking step.
+
+    Parameters
+    ----------
+    p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes, ev_t, ev_kft, \
+summary, y_init
+        As for :func:`run`.
+    y, y1, yr, ytmp, f_end : ndarray, shape (N_STATE,)
+        Work: the state, the end of a step, a trial state of the root search, the stage point
+        and the derivative at the end of a step.
+    stages : ndarray, shape (7, N_STATE)
+        Work: the Runge-Kutta stages.
+    w7, w7b : ndarray, shape (N_SOLVE_OUT,)
+        Work: accelerations and forces.
+    K : ndarray, shape (3, 3)
+        Work of the impact law.
+    g0, g1, gw : ndarray, shape (N_EVENTS,)
+        Work: the event functions at both ends of a step and in the root search.
+    span_work : ndarray, shape (N_SPAN_WORK,)
+        Work of the closed-form spans.
+    armed : ndarray of bool, shape (N_EVENTS,)
+        Work: which events may fire (all True on entry).
+    ms : ndarray of int, shape (6,)
+        Work: the mode state.
+    """
+    p = parameter_tuple(p_vec)
+    n = ax.shape[0]
+    fsal = False  # stages[0] holds f(y) in the current mode
     log_size = ev_t.shape[0] if store else 0
     n_ev = 0
     for i in range(N_SUMMARY):
@@ -859,7 +894,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     ) + potential_energy(p, y[Y_TH])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def store_sample(p, ms, y, hist, modes, k, failed):
     """Write the state, kinetic and potential energy and mode of sample ``k``."""
     for i in range(N_STATE):
