@@ -223,9 +223,10 @@ def simulate(
 
 
 def _summary_dict(summary: np.ndarray, system: ShipBlockSystem) -> dict:
-    out = {name: float(summary[i]) for name, i in SUMMARY_FIELDS.items()}
+    values = summary.tolist()  # Python floats at once, not one conversion per field
+    out = {name: values[i] for name, i in SUMMARY_FIELDS.items()}
     for m, name in enumerate(MODE_TIME_FIELDS):
-        out[name] = float(summary[K.S_MODE_TIME + m])
+        out[name] = values[K.S_MODE_TIME + m]
     out["peak_rotation_ratio"] = out["peak_rotation"] / system.critical_angle
     out["uplift"] = bool(out["uplift"])
     out["n_impacts"] = int(out["n_impacts"])
