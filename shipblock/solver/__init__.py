@@ -49,17 +49,22 @@ SUMMARY_FIELDS = {
 MODE_TIME_FIELDS = [f"time_in_mode_{m}" for m in range(1, 9)]
 
 
-def _as_acceleration(values, name: str) -> np.ndarray:
+def _as_acceleration(values, name: str, check_finite: bool = True) -> np.ndarray:
     arr = np.asarray(values, dtype=float)
     if arr.ndim != 1:
         raise ParameterError(f"{name} must be a one-dimensional array, got shape {arr.shape}")
     if arr.size < 2:
         raise ParameterError(f"{name} must have at least 2 samples, got {arr.size}")
+    if check_finite:
+        _check_finite(arr, name)
+    return np.ascontiguousarray(arr)
+
+
+def _check_finite(arr: np.ndarray, name: str) -> None:
     bad = ~np.isfinite(arr)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise ParameterError(f"{name} has {int(bad.sum())} non-finite samples (first at index {i})")
-    return np.ascontiguousarray(arr)
 
 
 def _check_options(dt, rtol, atol, zeno_omega):
@@ -274,26 +279,44 @@ def simulate_batch(
     dts_arr = np.asarray(dts, dtype=float)
     if dts_arr.shape != (n_rec,):
         raise ParameterError(f"dts must give one sample interval per record ({n_rec})")
-    for i, d in enumerate(dts_arr):
+    checked = set()
+    for i, d in enumerate(dts_arr.tolist()):
+        if d in checked:
+            continue
         try:
-            _check_options(float(d), rtol, atol, zeno_omega)
+            _check_options(d, rtol, atol, zeno_omega)
         except ValueError as exc:
             raise ParameterError(f"record {i}: {exc}") from None
+        checked.add(d)
     hs, vs, has_v = [], [], []
     for i, (h, v) in enumerate(records):
-        h = _as_acceleration(h, f"records[{i}] horizontal")
+        # finiteness is checked below on all records at once (one pass, not one per record)
+        h = _as_acceleration(h, f"records[{i}] horizontal", check_finite=False)
         hs.append(h)
         if v is None:
             vs.append(h)  # a stand-in the kernel never reads (has_v False)
             has_v.append(False)
         else:
-            v = _as_acceleration(v, f"records[{i}] vertical")
+            v = _as_acceleration(v, f"records[{i}] vertical", check_finite=False)
             if v.size != h.size:
                 raise ParameterError(f"records[{i}]: horizontal and vertical lengths differ")
             vs.append(v)
             has_v.append(True)
     offsets = np.zeros(n_rec + 1, dtype=np.int64)
     offsets[1:] = np.cumsum([h.size for h in hs])
+    acc_h = np.concatenate(hs)
+    # without any vertical component the horizontal stands in (never read): a second array of
+    # the records' size costs page faults out of proportion to a batch of short records
+    acc_v = np.concatenate(vs) if any(has_v) else acc_h
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = np.add.reduce(acc_h) + (np.add.reduce(acc_v) if any(has_v) else 0.0)
+    if not math.isfinite(total):
+        # a NaN or infinity makes the sum non-finite (so may an overflow of finite samples):
+        # find the record and sample to name
+        for i, (h, v) in enumerate(zip(hs, vs)):
+            _check_finite(h, f"records[{i}] horizontal")
+            if has_v[i]:
+                _check_finite(v, f"records[{i}] vertical")
     cases = np.asarray(cases, dtype=float)
     if cases.ndim != 2 or cases.shape[1] != 4:
         raise ParameterError("cases must have shape (n_cases, 4): record, system, scale_h, scale_v")
@@ -309,10 +332,6 @@ def simulate_batch(
     n_threads = numba.get_num_threads()
     order = np.argsort(np.arange(cases.shape[0]) % n_threads, kind="stable")
     dealt = np.empty((cases.shape[0], K.N_SUMMARY))
-    acc_h = np.concatenate(hs)
-    # without any vertical component the horizontal stands in (never read): a second array of
-    # the records' size costs page faults out of proportion to a batch of short records
-    acc_v = np.concatenate(vs) if any(has_v) else acc_h
     K.run_many(
         params,
         acc_h,
@@ -329,11 +348,12 @@ def simulate_batch(
         zeno_omega,
         dealt,
     )
-    summaries = np.empty_like(dealt)
-    summaries[order] = dealt
-    out = {name: summaries[:, i].copy() for name, i in SUMMARY_FIELDS.items()}
+    # one field per row, each row contiguous: the arrays returned are views of one block
+    by_field = np.empty((K.N_SUMMARY, cases.shape[0]))
+    by_field[:, order] = dealt.T
+    out = {name: by_field[i] for name, i in SUMMARY_FIELDS.items()}
     for m, name in enumerate(MODE_TIME_FIELDS):
-        out[name] = summaries[:, K.S_MODE_TIME + m].copy()
+        out[name] = by_field[K.S_MODE_TIME + m]
     thc = params[par_idx, P_THC]
     out["peak_rotation_ratio"] = out["peak_rotation"] / thc
     return out
