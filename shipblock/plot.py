@@ -113,7 +113,14 @@ def active_window(time, acc, events=(), margin=2.0, end=None):
     return max(time[0], t0 - margin), min(time[-1], t1 + 1.5 * margin)
 
 
-def plot_response(result, axes=None, max_event_lines=400, window="auto"):
+#: Slip starts and stops are drawn as lines only up to this many (see :func:`plot_response`).
+MAX_SLIP_EVENT_LINES = 40
+
+SLIP_EVENTS = ("ground_slip_start", "ground_slip_stop", "ship_slip_start", "ship_slip_stop")
+
+
+def plot_response(result, axes=None, max_event_lines=400, window="auto",
+                  max_slip_event_lines=MAX_SLIP_EVENT_LINES):
     """Response history: ground acceleration, block slip, rotation, ship slip, modes, events.
 
     Parameters
@@ -124,6 +131,10 @@ def plot_response(result, axes=None, max_event_lines=400, window="auto"):
         Panels for ground acceleration, x_b, theta and x_s; a new figure when None.
     max_event_lines : int, optional
         Draw at most this many impact lines (dense Zeno sequences are thinned).
+    max_slip_event_lines : int, optional
+        Draw slip starts and stops as lines only if there are at most this many: a stick-slip
+        record has hundreds, whose lines would hide the curves, and the mode bands show the
+        same (the legend gives their number).
     window : "auto", None or (t0, t1), optional
         Time axis limits [s]; "auto" shows 1-99 % of the Arias intensity and every event.
 
@@ -179,8 +190,10 @@ def plot_response(result, axes=None, max_event_lines=400, window="auto"):
     for e in impacts[::stride]:
         for ax in axes[1:4]:
             ax.axvline(e.time, **EVENT_STYLES["impact"], zorder=1)
+    n_slip = sum(e.kind in SLIP_EVENTS for e in result.events)
+    draw_slips = n_slip <= max_slip_event_lines
     for e in result.events:
-        if e.kind in ("impact", "start"):
+        if e.kind in ("impact", "start") or (e.kind in SLIP_EVENTS and not draw_slips):
             continue
         style = EVENT_STYLES.get(e.kind)
         if style is None:
@@ -194,6 +207,10 @@ def plot_response(result, axes=None, max_event_lines=400, window="auto"):
     handles = [Patch(facecolor=MODE_COLOURS[m], edgecolor="0.6", label=f"{m}: {MODE_DESCRIPTIONS[m]}")
                for m in sorted(seen) if m >= 1]
     kinds = {e.kind for e in result.events} - {"start"}
+    if not draw_slips:
+        kinds -= set(SLIP_EVENTS)
+        handles.append(Patch(facecolor="none", edgecolor="none",
+                             label=f"{n_slip} slip starts and stops: see the mode bands"))
     handles += [Line2D([], [], **EVENT_STYLES[k], label=k.replace("_", " ")) for k in sorted(kinds)
                 if k in EVENT_STYLES]
     if handles:

@@ -130,6 +130,37 @@ def test_response_figure_window_ends_at_the_failure_and_keeps_labels_inside():
     assert 0.0 <= label[0].get_position()[0] <= 1.0
 
 
+def test_response_figure_draws_slip_lines_only_when_few():
+    """Hundreds of slip starts and stops would hide the curves: beyond the limit they are left
+    to the mode bands and counted in the legend; below it each is a line."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import numpy as np
+
+    from shipblock import ShipBlockSystem, simulate
+    from shipblock.plot import SLIP_EVENTS, plot_response
+
+    t = np.arange(0, 20, 0.01)
+    system = ShipBlockSystem(ship_mass=5e6, block_mass=1200.0, n_blocks=150, half_width=1.5,
+                             half_height=0.5, mu_s_ground=0.1, mu_k_ground=0.1, mu_s_ship=0.6,
+                             mu_k_ship=0.55)
+    res = simulate(system, 2.0 * np.sin(2 * np.pi * 2.0 * t), None, 0.01)
+    n_slip = sum(e.kind in SLIP_EVENTS for e in res.events)
+    assert n_slip > 40
+
+    def vertical_lines(axes):
+        return sum(len([ln for ln in ax.get_lines() if len(set(ln.get_xdata())) == 1])
+                   for ax in axes[1:4])
+
+    many = plot_response(res)
+    assert vertical_lines(many) == 0
+    labels = [txt.get_text() for txt in many[3].get_legend().get_texts()]
+    assert f"{n_slip} slip starts and stops: see the mode bands" in labels
+    few = plot_response(res, max_slip_event_lines=n_slip)
+    assert vertical_lines(few) == 3 * n_slip  # one line per event in each of three panels
+
+
 def test_run_says_why_a_limit_state_was_not_fitted(tmp_path, capsys):
     """A limit state whose fit failed (e.g. beta not identified) is reported with the reason
     kept in the dataset's fit_error, never as a 'nan' median."""
