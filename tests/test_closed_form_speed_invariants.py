@@ -10,7 +10,13 @@ import pytest
 
 from shipblock import ShipBlockSystem, simulate, simulate_batch
 from shipblock.equations import solve_mode
-from shipblock.solver._closed_form import REST_BLOCK, rest_breaks, skip_rest, slip_may_stop
+from shipblock.solver._closed_form import (
+    add_repeated,
+    rest_breaks,
+    rest_interval,
+    skip_rest,
+    slip_may_stop,
+)
 from shipblock.solver._layout import parameter_tuple
 from shipblock.system import P_B, P_G, P_H, P_MUS1, P_MUS2
 
@@ -71,8 +77,9 @@ def span_rest_screen(a1, b1, c):
             or mus1 * fy1 < abs(fx1) or mus2 * Fy1 < abs(Fx1))
 
 
+@pytest.mark.parametrize("fast", [True, False])
 @pytest.mark.parametrize("has_ay", [True, False])
-def test_rest_blocks_skip_exactly_the_passing_samples(has_ay):
+def test_rest_blocks_skip_exactly_the_passing_samples(has_ay, fast):
     system = ShipBlockSystem.example()
     c = rest_coefficients(system)
     rng = np.random.default_rng(2)
@@ -87,15 +94,50 @@ def test_rest_blocks_skip_exactly_the_passing_samples(has_ay):
     assert breaks.sum() > 10
     for j in range(n):
         assert rest_breaks(ax[j], ay[j], has_ay, sh, sv, *c) == breaks[j]
-    for k0 in list(rng.choice(n - 1, 60, replace=False)) + [0, n - REST_BLOCK - 1, n - 2]:
-        k, time = skip_rest(ax, ay, has_ay, sh, sv, int(k0), dt, 0.25, *c)
+    lo, hi = rest_interval(*c) if fast and not has_ay else (1.0, -1.0)
+    for k0 in list(rng.choice(n - 1, 60, replace=False)) + [0, n - 40, n - 2]:
+        k, time = skip_rest(ax, ay, has_ay, sh, sv, int(k0), dt, 0.25, *c, lo, hi)
         assert k0 <= k <= n - 1
         assert not breaks[k0 + 1:k + 1].any()  # nothing skipped that the screen would stop at
-        assert k + REST_BLOCK >= n or breaks[k + 1:k + 1 + REST_BLOCK].any()  # stops at a break
+        assert k == n - 1 or breaks[k + 1]  # stops at the first break
         want = 0.25
         for _ in range(k - k0):
             want += dt  # interval by interval, as the span adds it
         assert time == want
+
+
+def test_rest_interval_passes_the_screen_near_its_ends():
+    c = rest_coefficients(ShipBlockSystem.example())
+    lo, hi = rest_interval(*c)
+    assert lo < 0.0 < hi
+    a = np.concatenate([np.linspace(lo, hi, 2001), lo + (hi - lo) * 1e-12 * np.arange(50),
+                        hi - (hi - lo) * 1e-12 * np.arange(50)])
+    assert not any(rest_breaks(x, 0.0, False, 1.0, 0.0, *c) for x in a)
+    # and it is not much narrower than the screen: slightly beyond either end rest breaks
+    assert rest_breaks(lo * (1 + 1e-6), 0.0, False, 1.0, 0.0, *c)
+    assert rest_breaks(hi * (1 + 1e-6), 0.0, False, 1.0, 0.0, *c)
+
+
+def test_repeated_addition_equals_the_loop():
+    rng = np.random.default_rng(3)
+    cases = []
+    for _ in range(20000):
+        dt = float(rng.choice([0.005, 0.01, 0.02, 0.0025, 1 / 3])) if rng.random() < 0.7 \
+            else 10.0 ** rng.uniform(-6, 0)
+        t = 0.0 if rng.random() < 0.1 else dt * int(rng.integers(0, 5000)) * rng.choice(
+            [1.0, 1.0 + 1e-12]) if rng.random() < 0.5 else rng.uniform(0.0, 60.0)
+        cases.append((t, dt, int(rng.integers(0, 6000))))
+    # ties: dt an odd number of half ulps of t, whose rounding depends on the parity of t
+    for e in range(-8, 6):
+        u = 2.0 ** (e - 53)
+        for m in (1, 3, 5, 101):
+            for t in (2.0 ** (e - 1), 2.0 ** (e - 1) + u, 0.75 * 2.0 ** e):
+                cases.append((t, m * 0.5 * u, 9))
+    for t, dt, n in cases:
+        want = t
+        for _ in range(n):
+            want += dt
+        assert add_repeated(t, dt, n) == want, (t, dt, n)
 
 
 def test_event_log_longer_than_the_record():

@@ -16,9 +16,10 @@ samples a and G are linear in time, so within a sample interval
 compiled code or touching the general event machinery, which is what makes sliding and rest
 phases cheap. At rest nothing moves and whether an interval may hold an event depends on the
 input at its end alone, so long rest phases are screened a block of samples at a time
-(:func:`skip_rest`, about a nanosecond per sample). The span stops at the first event, with the
-state advanced exactly to it (the same polynomials, cut at the root), and returns the event for
-the general kernel to apply.
+(:func:`skip_rest`; without a vertical input, mostly by two comparisons a sample against the
+interval of accelerations at which rest surely holds). The span stops at the first event, with
+the state advanced exactly to it (the same polynomials, cut at the root), and returns the event
+for the general kernel to apply.
 
 The functions called once per span or per event are compiled without numba's reference
 counting (``_nrt=False``; they neither allocate nor return arrays): it would otherwise update
@@ -71,6 +72,9 @@ from shipblock.solver._layout import (
     W_INV_W,
     W_INV_WR,
     W_INV_WS,
+    W_REST_HI,
+    W_REST_LO,
+    W_REST_SET,
     W_RESP,
     W_RESP_STATE,
     Y_DIS,
@@ -85,6 +89,11 @@ from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 NO_ROOT = math.inf
 #: Samples screened at once at rest (see :func:`skip_rest`).
 REST_BLOCK = 32
+#: Samples of a rest phase screened one by one before :func:`skip_rest` takes over.
+REST_FIRST = 32
+#: Samples checked at once against the interval of :func:`rest_interval`: a loop of 32 so
+#: short would be unrolled whole and not vectorised.
+FAST_BLOCK = 64
 
 
 @njit(cache=True, error_model="numpy")
@@ -243,14 +252,100 @@ def rest_breaks(ax_j, ay_j, has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, 
             | (mus1 * fy1 < abs(fx1)) | (mus2 * Fy1 < abs(Fx1)))
 
 
+@njit(cache=True, error_model="numpy")
+def rest_interval(grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H):
+    """Horizontal accelerations ``[lo, hi]`` at which rest surely passes the screen of
+    :func:`rest_breaks` when there is no vertical input (``lo > hi`` if none is known).
+
+    With ``G = g`` and the normal forces independent of ``a`` (as they are at rest), every
+    condition of the screen reads ``|s a + q| <= r``: an interval of ``a``. Their intersection
+    is shrunk by a margin (1e-9 relative) far above the round-off of the screen's arithmetic,
+    so a sample inside passes the screen as computed; a sample outside is screened as before.
+    """
+    empty = (1.0, -1.0)
+    if fy_a != 0.0 or Fy_a != 0.0 or not H > 0.0:
+        return empty
+    fy = fy_g * grav  # as the screen computes fy_a a + fy_g G with fy_a = 0
+    Fy = Fy_g * grav
+    if not (fy > 0.0 and Fy > 0.0):
+        return empty
+    lo = -math.inf
+    hi = math.inf
+    for i in range(3):
+        if i == 0:  # the moment criterion
+            s, q, r = fx_a + Fx_a, (fx_g + Fx_g) * grav, B * (fy + Fy) / H
+        elif i == 1:  # the ground friction cone
+            s, q, r = fx_a, fx_g * grav, mus1 * fy
+        else:  # the ship's
+            s, q, r = Fx_a, Fx_g * grav, mus2 * Fy
+        margin = 1e-9 * (abs(q) + abs(r))
+        if s == 0.0:
+            if not abs(q) < r - margin:
+                return empty
+            continue
+        c = -q / s
+        w = (r - margin) / abs(s)
+        lo = max(lo, c - w)
+        hi = min(hi, c + w)
+    if not (lo <= hi and math.isfinite(lo) and math.isfinite(hi)):
+        return empty
+    # the ends themselves pass the screen (a check of the margin's argument)
+    if rest_breaks(lo, 0.0, False, 1.0, 0.0, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a,
+                   Fy_g, mus1, mus2, B, H) or rest_breaks(
+            hi, 0.0, False, 1.0, 0.0, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g,
+            mus1, mus2, B, H):
+        return empty
+    return lo, hi
+
+
+@njit(cache=True, error_model="numpy")
+def add_repeated(t, dt, n):
+    """``t`` with ``dt > 0`` added ``n`` times, rounded after each addition: the same value as
+    the loop of ``n`` additions, in a few operations per power of two passed.
+
+    ``t`` is a multiple of its ulp ``u``, and while the sums stay below the next power of two
+    they are rounded to multiples of ``u``; unless ``dt`` lies exactly halfway between two of
+    them (a tie, broken by the parity of ``t``), each addition then adds the same exact
+    increment ``d = (t + dt) - t``, and ``m`` additions add ``m d``, exactly. So the additions
+    are made ``m`` at a time up to the next power of two, and one by one across it (and
+    wherever that cannot be shown: a tie, ``t`` zero or not normal).
+
+    The loop is one serial chain of additions, a few cycles each: the time of a long rest
+    phase (see :func:`skip_rest`) would cost more than screening its samples.
+    """
+    while n > 0:
+        if 1e-300 < t < 1e300:
+            top = math.ldexp(1.0, math.frexp(t)[1])  # the power of two above t
+            u = math.ldexp(top, -53)  # ulp of t
+            d = (t + dt) - t  # exact: both multiples of u (or m below is 0)
+            if abs(dt - d) != 0.5 * u:
+                if d == 0.0:
+                    return t  # dt below half an ulp: no addition changes t
+                # m d <= top - t - u (exact right side): each sum t + i d + dt, i < m, ends
+                # below top (dt <= d + u / 2); and m d, a multiple of u below top, is exact
+                room = (top - t) - u
+                m = min(n, int(room / d))
+                while m > 0 and m * d > room:
+                    m -= 1  # the quotient rounded up
+                t += m * d
+                n -= m
+        if n > 0:
+            t += dt
+            n -= 1
+    return t
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g,
-              Fy_a, Fy_g, mus1, mus2, B, H):
-    """Advance rest from sample ``k`` over whole blocks of ``REST_BLOCK`` intervals that all
-    pass the screen (see :func:`rest_breaks`), stopping before the first that does not.
+              Fy_a, Fy_g, mus1, mus2, B, H, lo, hi):
+    """Advance rest from sample ``k`` to the first interval that fails the screen (see
+    :func:`rest_breaks`), or to the end of the record.
 
-    A block is screened at once, with no branches in the loop: vectorised, a fraction of the
-    cost of the sample-by-sample loop.
+    Blocks of ``REST_BLOCK`` intervals are screened at once, with no branches in the loop
+    (vectorised, a fraction of the cost of the sample-by-sample loop): first ``FAST_BLOCK``
+    intervals by whether their accelerations lie in ``[lo, hi]`` (two comparisons a sample),
+    else ``REST_BLOCK`` by the screen itself, the first failing interval found by a minimum
+    over the block's indices. The time is added at the end (:func:`add_repeated`).
 
     Parameters
     ----------
@@ -262,30 +357,50 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
         Time in the mode so far [s].
     grav, fx_a, ..., H : float
         As :func:`rest_breaks` takes them.
+    lo, hi : float
+        Scaled horizontal accelerations at which rest surely passes the screen
+        (:func:`rest_interval`; ``lo > hi`` for none, as with a vertical input).
 
     Returns
     -------
     k : int
-        Where rest goes on sample by sample.
+        The sample whose interval fails the screen (``n - 1`` at the end of the record).
     time : float
         The time in the mode, with ``dt`` added interval by interval as the span adds it.
     """
     n = ax.shape[0]
-    while k + REST_BLOCK < n:
+    k0 = k
+    while True:
+        if k + REST_BLOCK >= n:
+            # the last samples, one by one
+            while k < n - 1 and not rest_breaks(ax[k + 1], ay[k + 1], has_ay, sh, sv, grav,
+                                                 fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a,
+                                                 Fy_g, mus1, mus2, B, H):
+                k += 1
+            break
         # indices from 0 in a slice, so that the loads are contiguous (no negative-index
         # wraparound to allow for) and vectorise without gathers
+        if lo <= hi and k + FAST_BLOCK < n:
+            bx = ax[k + 1:k + 1 + FAST_BLOCK]
+            outside = 0
+            for j in range(FAST_BLOCK):
+                a1 = sh * bx[j]  # as rest_breaks scales it
+                outside += (a1 < lo) | (a1 > hi)
+            if outside == 0:
+                k += FAST_BLOCK
+                continue
         bx = ax[k + 1:k + 1 + REST_BLOCK]
         by = ay[k + 1:k + 1 + REST_BLOCK]
-        bad = 0
+        first = REST_BLOCK
         for j in range(REST_BLOCK):
-            bad += rest_breaks(bx[j], by[j], has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a,
-                               Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
-        if bad:
+            bad = rest_breaks(bx[j], by[j], has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a,
+                              Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
+            first = min(first, j if bad else REST_BLOCK)
+        if first < REST_BLOCK:
+            k += first
             break
-        for _ in range(REST_BLOCK):
-            time += dt
-        k += REST_BLOCK
-    return k, time
+        k += REST_BLOCK  # not k += first: the next block's loads need not wait for the minimum
+    return k, add_repeated(time, dt, k - k0)
 
 
 @njit(cache=True, inline="always")
@@ -329,7 +444,8 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         modes its state (0 not solved yet, 1 solved, 2 singular) and response vectors ``w_a``,
         ``w_G``, solved on a mode's first span and reused by its later spans in the run (a
         stick-slip record enters the same few modes thousands of times); the inverse weights
-        that scale the event functions, set by the first span.
+        that scale the event functions, set by the first span; the interval of
+        :func:`rest_interval`, set by the first long rest phase.
 
     Returns
     -------
@@ -378,23 +494,26 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
     if not slip1 and not slip2 and all_armed and y[Y_VB] == 0.0 and y[Y_VS] == 0.0:
         # Rest: nothing moves and an interval passes the screen on the input at its end alone.
         # The first intervals are screened one by one (rest often ends within a few), then
-        # whole blocks at once; the loop below takes over at the first that fails.
+        # skip_rest goes on up to the first that fails, where the loop below takes over.
         k_first = k
-        while k < n - 1 and k - k_first < REST_BLOCK and not rest_breaks(
+        while k < n - 1 and k - k_first < REST_FIRST and not rest_breaks(
                 ax[k + 1], ay[k + 1], has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g,
                 Fy_a, Fy_g, mus1, mus2, B, H):
             time_in_mode += dt - tau
             tau = 0.0
             k += 1
-            if store:
-                _store(p, y, hist, modes, k, mode)
-        if k - k_first == REST_BLOCK:
-            k_first = k
+        if k - k_first == REST_FIRST:
+            if work[W_REST_SET] == 0.0:
+                # once per run (the rest response is the same in every rest span)
+                work[W_REST_LO], work[W_REST_HI] = rest_interval(
+                    grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
+                work[W_REST_SET] = 1.0
+            lo, hi = (work[W_REST_LO], work[W_REST_HI]) if not has_ay else (1.0, -1.0)
             k, time_in_mode = skip_rest(ax, ay, has_ay, sh, sv, k, dt, time_in_mode, grav, fx_a,
                                         fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B,
-                                        H)
-            if store:
-                _store_rest(p, y, hist, modes, k_first + 1, k + 1, mode)
+                                        H, lo, hi)
+        if store and k > k_first:
+            _store_rest(p, y, hist, modes, k_first + 1, k + 1, mode)
     a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # start of the interval
     G0 = grav + b0
     fx0 = fx_a * a0 + fx_g * G0

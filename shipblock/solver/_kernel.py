@@ -481,8 +481,10 @@ def select_mode(p, y, ms, a, b, trigger, w7):
         key2 = order[jc] // 512
         mode = (order[jc] // 32) % 16
         slip1, sig1, new1, rock, s, newr, slip2, sig2, new2 = candidate_options(idx, vb, rot, vs)
-        ok = solve_mode(p, slip1, rock, slip2, float(s), float(sig1), float(sig2),
-                        th, om, a, G, w7)
+        # solve_mode without its wrapper's call: this runs for one to three candidates per event
+        c, sn = pivot_geometry(p, th, float(s), rock)
+        ok = solve_mode_at(p, slip1, rock, slip2, float(s), float(sig1), float(sig2), c, sn, om,
+                           a, G, w7)
         if not ok:
             continue
         fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]

@@ -72,7 +72,12 @@ W_RESP = W_RESP_STATE + N_RESP_SLOTS
 W_INV_W = W_RESP + 2 * N_SOLVE_OUT * N_RESP_SLOTS  # 1 / weight
 W_INV_WS = W_INV_W + 1  # 1 / ship weight
 W_INV_WR = W_INV_W + 2  # 1 / (weight R)
-N_SPAN_WORK = W_INV_W + 3
+# the horizontal accelerations at which rest surely holds without a vertical input (see
+# ``rest_interval``), set by the first rest span: a flag (0 not set yet), then the bounds
+W_REST_SET = W_INV_W + 3
+W_REST_LO = W_INV_W + 4
+W_REST_HI = W_INV_W + 5
+N_SPAN_WORK = W_INV_W + 6
 
 # Numerical constants (documented in docs/theory/solver.md).
 ROOT_TIME_TOL = 1e-12  # [s] width of the bracket that locates an event
