@@ -313,7 +313,7 @@ def simulate_batch(
     if not math.isfinite(total):
         # a NaN or infinity makes the sum non-finite (so may an overflow of finite samples):
         # find the record and sample to name
-        for i, (h, v) in enumerate(zip(hs, vs)):
+        for i, (h, v) in enumerate(zip(hs, vs, strict=True)):
             _check_finite(h, f"records[{i}] horizontal")
             if has_v[i]:
                 _check_finite(v, f"records[{i}] vertical")
