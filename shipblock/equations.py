@@ -206,6 +206,81 @@ def solve_mode_at(p, slip1, rock, slip2, s, sig1, sig2, c, sn, omega, a, G, out)
     return True
 
 
+@njit(cache=True, inline="always")
+def stuck_rocking_gain(p):
+    """:math:`(nm + 2M)R / (nI + (nm + 4M)R^2)` [1/m] of :func:`stuck_rocking_rates`."""
+    R = p[P_R]
+    return (p[P_NM] + 2.0 * p[P_M]) * R / (p[P_NI] + (p[P_NM] + 4.0 * p[P_M]) * R * R)
+
+
+@njit(cache=True, inline="always")
+def stuck_rocking_rates(p, gain, c, sn, s, omega, a, ay):
+    """Angular acceleration and input power of the rocking mode on two stuck interfaces.
+
+    With :math:`\\ddot x_b = \\ddot x_s = 0` (and no slip velocities) row 1 of
+    :func:`solve_mode` reduces to a pendulum equation: the centripetal terms cancel between the
+    two force rows and :math:`c^2 + \\bar s^2 = 1` leaves a constant inertia,
+
+    .. math::
+
+        \\ddot\\theta = \\frac{(nm + 2M)R}{nI + (nm + 4M)R^2}\\,(c\\,a - s\\bar s\\,G),
+        \\qquad
+        P = (nm + 2M)R\\,\\dot\\theta\\,(c\\,a - s\\bar s\\,\\ddot y_g),
+
+    with :math:`G = g + \\ddot y_g`; :math:`P` is :func:`input_power_at` with no slip
+    velocities. For a single block (:math:`M = 0`, :math:`n = 1`) this is Housner's
+    :math:`I_O\\ddot\\theta = -mR(g\\sin(\\theta_c - \\theta) - \\ddot x_g \\cos(\\theta_c - \\theta))`
+    for :math:`\\theta > 0` in this sign convention (positive ground acceleration tips the
+    block about its left corner). The rocking steps of the solver evaluate the mode through this
+    form (about a fifth of the general solve's arithmetic); ``tests/test_equations.py`` checks
+    it symbolically and numerically against the general solve.
+
+    Parameters
+    ----------
+    p : ndarray or tuple
+        Parameter vector.
+    gain : float
+        :func:`stuck_rocking_gain` of ``p`` [1/m].
+    c, sn : float
+        :func:`pivot_geometry` at the rotation (cos and sin of theta_c - s theta).
+    s : float
+        Pivot sign.
+    omega : float
+        Angular velocity [rad/s].
+    a, ay : float
+        Horizontal and vertical ground acceleration [m/s^2].
+
+    Returns
+    -------
+    theta_dd : float
+        Angular acceleration [rad/s^2].
+    power : float
+        Input power of the ground motion [W].
+    """
+    ssn = s * sn
+    theta_dd = gain * (c * a - ssn * (p[P_G] + ay))
+    power = (p[P_NM] + 2.0 * p[P_M]) * p[P_R] * omega * (c * a - ssn * ay)
+    return theta_dd, power
+
+
+@njit(cache=True, inline="always")
+def stuck_rocking_forces(p, c, sn, s, omega, theta_dd, a, G):
+    """Interface forces ``(fx, fy, Fx, Fy)`` [N] of the rocking mode on two stuck interfaces.
+
+    The force rows of :func:`solve_mode` with :math:`\\ddot x_b = \\ddot x_s = 0`:
+    :math:`F_x = M(a + 2X')`, :math:`F_y = M(G + 2Y')`, :math:`f_x = nm(a + X') + F_x`,
+    :math:`f_y = nm(G + Y') + F_y`, with ``theta_dd`` from :func:`stuck_rocking_rates`.
+    """
+    Rc = p[P_R] * c
+    Rss = p[P_R] * s * sn
+    w2 = omega * omega
+    xp = -(Rc * theta_dd + Rss * w2)
+    yp = Rss * theta_dd - Rc * w2
+    Fx = p[P_M] * (a + 2.0 * xp)
+    Fy = p[P_M] * (G + 2.0 * yp)
+    return p[P_NM] * (a + xp) + Fx, p[P_NM] * (G + yp) + Fy, Fx, Fy
+
+
 @njit(cache=True)
 def mass_matrix(p, theta, s, rock, K):
     """Fill ``K`` (3x3) with the kinetic-energy matrix, T = 1/2 qdot^T K qdot.

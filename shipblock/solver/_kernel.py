@@ -114,6 +114,7 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     Y_XS,
     parameter_tuple,
 )
+from shipblock.solver._stuck_rocking import advance_stuck
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
 
@@ -142,20 +143,42 @@ def rhs(p, ms, y, a, ay, stages, st, w7):
 
 @njit(cache=True, inline="always")
 def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
-            first_stage_known=False):
-    """One Dormand-Prince 5(4) step of ``h`` within sample interval ``k``: 0, or -1 if singular.
+            first_stage_known, rtol, atol):
+    """One Dormand-Prince 5(4) step of ``h`` within sample interval ``k``: its error norm.
 
+    Returns the RMS of the embedded error estimate scaled by ``atol + rtol*|y|``
+    (:func:`error_norm`), or -1 if the equations are singular. ``y1`` gets the 5th-order
+    solution, ``stages[6]`` the rates there and ``w7`` the accelerations and forces there.
     Used for rocking modes (rest and sliding are advanced in closed form by
-    :func:`~shipblock.solver._closed_form.nonrocking_span`). The error estimate is read from
-    ``stages`` by :func:`error_norm`. With ``first_stage_known`` the first stage, f(t, y0), is
-    taken from ``stages[0]`` as left there by the previous step (first same as last) or by an
-    earlier step from the same ``y0``.
+    :func:`~shipblock.solver._closed_form.nonrocking_span`). With ``first_stage_known`` the
+    first stage, f(t, y0), is taken from ``stages[0]`` as left there by the previous step
+    (first same as last) or by an earlier step from the same ``y0``.
+
+    The usual rocking mode, on two stuck interfaces, takes the same step on its three moving
+    states (:func:`~shipblock.solver._stuck_rocking.advance_stuck`).
     """
-    n = y0.shape[0]
     if h == 0.0:
-        for i in range(n):
+        for i in range(y0.shape[0]):
             y1[i] = y0[i]
         return 0.0
+    if (ms[MS_ROCK] and not ms[MS_SLIP1] and not ms[MS_SLIP2] and y0[Y_VB] == 0.0
+            and y0[Y_VS] == 0.0):
+        return advance_stuck(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, w7,
+                             first_stage_known, rtol, atol)
+    if not advance_general(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp,
+                           w7, first_stage_known):
+        return -1.0
+    return error_norm(y0, y1, stages, h, rtol, atol)
+
+
+@njit(cache=True, inline="always")
+def advance_general(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
+                    first_stage_known):
+    """The step of :func:`advance` in any rocking mode, on the whole state: False if singular.
+
+    The error estimate is left in ``stages`` for :func:`error_norm`.
+    """
+    n = y0.shape[0]
     # the step stays within sample interval k, where the input is linear in time
     # (the same arithmetic as ground_motion_at)
     a0 = sh * ax[k]
@@ -172,10 +195,10 @@ def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, 
             ytmp[i] = acc
         f = (tau + DP_C[st] * h) / dt
         if not rhs(p, ms, ytmp, a0 + (a1 - a0) * f, b0 + (b1 - b0) * f, stages, st, w7):
-            return -1.0
+            return False
     for i in range(n):
         y1[i] = ytmp[i]  # the 7th stage point is the 5th-order solution (FSAL)
-    return 0.0
+    return True
 
 
 @njit(cache=True, inline="always")
@@ -240,7 +263,8 @@ def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages,
 
     Called only after a step from ``y0``, so ``stages[0]`` already holds f(t, y0).
     """
-    advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, True)
+    advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, True, 1.0,
+            1.0)
     if e == EV_ROTATION_PEAK:
         return y1[Y_OM] if y0[Y_OM] > 0.0 else -y1[Y_OM]
     event_values(p, ms, y1, k, tau + h, dt, ax, ay, has_ay, sh, sv, g, w7)
@@ -668,13 +692,12 @@ summary, y_init
             remaining = dt - tau
             h = min(h_rock, remaining)
             err = advance(p, ms, y, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
-                          fsal)
+                          fsal, rtol, atol)
             fsal = True  # stages[0] holds f(y) now, whatever happens to this step
             if err < 0.0:
                 failure = Failure.SOLVER_ERROR
                 failure_time = k * dt + tau
                 break
-            err = error_norm(y, y1, stages, h, rtol, atol)
             if err > 1.0:
                 h_rock = h * max(MIN_FACTOR, SAFETY * err ** (-1.0 / (DP_ERROR_ORDER + 1)))
                 if h_rock < MIN_STEP:
@@ -773,7 +796,7 @@ summary, y_init
             # advance to the event (the closed-form span has done so already) and apply it
             if ms[MS_ROCK]:
                 advance(p, ms, y, k, tau, best_h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp,
-                        w7, fsal)
+                        w7, fsal, rtol, atol)
                 for i in range(N_STATE):
                     y[i] = y1[i]
                 summary[S_MODE_TIME + mode_number(ms) - 1] += best_h

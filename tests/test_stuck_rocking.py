@@ -1,0 +1,168 @@
+"""The rocking mode on two stuck interfaces in its reduced form, and the solver's step for it.
+
+:func:`shipblock.equations.stuck_rocking_rates` must be the general equations of mode 3
+(symbolically, from the independent derivation in ``sympy_model``, and numerically, against
+:func:`~shipblock.equations.solve_mode`), and the solver's mode-3 step
+(:mod:`shipblock.solver._stuck_rocking`) the same Dormand-Prince step as the general one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from numba import njit
+
+from shipblock import ShipBlockSystem
+from shipblock.equations import (
+    I_FX,
+    I_FY,
+    I_SFX,
+    I_SFY,
+    I_TH_DD,
+    N_SOLVE_OUT,
+    input_power,
+    solve_mode,
+    stuck_rocking_gain,
+    stuck_rocking_rates,
+)
+from shipblock.solver._kernel import advance, advance_general, error_norm
+from shipblock.solver._layout import (
+    MS_ROCK,
+    MS_S,
+    MS_SIG1,
+    MS_SIG2,
+    N_STATE,
+    Y_OM,
+    Y_TH,
+    Y_WIN,
+    parameter_tuple,
+)
+from shipblock.solver._stuck_rocking import SMALL_ANGLE, small_angle_sincos
+from shipblock.system import P_G, P_M, P_NM, P_R, P_THC
+
+try:  # tests/ as a package or as a plain directory
+    from . import sympy_model as sm
+except ImportError:
+    import sympy_model as sm
+
+
+def test_reduced_equation_is_mode_3_of_the_independent_derivation():
+    """theta'' of mode 3 (Lagrange derivation) == (nm+2M)R (c a - s sn G) / (nI + (nm+4M)R^2)."""
+    reduced = ((sm.nm + 2 * sm.M) * sm.R * (sm.cphi * sm.a - sm.s * sm.sphi * sm.G)
+               / (sm.nI + (sm.nm + 4 * sm.M) * sm.R**2))
+    assert sm.is_identity(sm.mode_solution(3)[sm.thdd] - reduced)
+    # a sign error in either term would not be an identity
+    wrong = ((sm.nm + 2 * sm.M) * sm.R * (sm.cphi * sm.a + sm.s * sm.sphi * sm.G)
+             / (sm.nI + (sm.nm + 4 * sm.M) * sm.R**2))
+    assert not sm.is_identity(sm.mode_solution(3)[sm.thdd] - wrong)
+
+
+def _random_system(rng):
+    return ShipBlockSystem(
+        ship_mass=rng.uniform(1e4, 1e7), block_mass=rng.uniform(100.0, 5000.0),
+        n_blocks=int(rng.integers(1, 200)), half_width=rng.uniform(0.05, 1.0),
+        half_height=rng.uniform(0.2, 2.0), mu_s_ground=0.9, mu_k_ground=0.8, mu_s_ship=0.9,
+        mu_k_ship=0.8)
+
+
+def test_reduced_rates_equal_general_solve():
+    rng = np.random.default_rng(3)
+    out = np.empty(N_SOLVE_OUT)
+    for _ in range(400):
+        system = _random_system(rng)
+        p = system.to_parameter_vector()
+        s = float(rng.choice([-1.0, 1.0]))
+        th = s * rng.uniform(0.0, system.critical_angle)
+        om = rng.uniform(-3.0, 3.0)
+        a, ay = rng.uniform(-10.0, 10.0, 2)
+        assert solve_mode(p, 0, 1, 0, s, 1.0, 1.0, th, om, a, p[P_G] + ay, out)
+        phi = p[P_THC] - s * th
+        al, power = stuck_rocking_rates(p, stuck_rocking_gain(p), math.cos(phi), math.sin(phi),
+                                        s, om, a, ay)
+        scale = stuck_rocking_gain(p) * (abs(a) + p[P_G] + abs(ay)) + 1e-300
+        assert abs(al - out[I_TH_DD]) <= 1e-12 * scale
+        ref = input_power(p, th, s, 1, 0.0, om, 0.0, a, ay)
+        pscale = (p[P_NM] + 2 * p[P_M]) * p[P_R] * abs(om) * (abs(a) + abs(ay)) + 1e-300
+        assert abs(power - ref) <= 1e-13 * pscale
+
+
+def test_small_angle_sincos():
+    d = np.linspace(-SMALL_ANGLE, SMALL_ANGLE, 20001)
+    for x in d:
+        sn, cs = small_angle_sincos(x)
+        assert abs(sn - math.sin(x)) <= 2.5e-16 * max(abs(x), 1e-300) + 1e-300
+        assert abs(cs - math.cos(x)) <= 2.5e-16
+
+
+@njit
+def _both_steps(p_vec, ms, y0, k, tau, h, dt, ax, ay, has_ay, first_known, rtol, atol):
+    """The mode-3 step through advance() and the general step, from the same start."""
+    p = parameter_tuple(p_vec)
+    n = y0.size
+    st_a = np.zeros((7, n))
+    st_b = np.zeros((7, n))
+    y1a = np.empty(n)
+    y1b = np.empty(n)
+    ytmp = np.empty(n)
+    w7a = np.empty(N_SOLVE_OUT)
+    w7b = np.empty(N_SOLVE_OUT)
+    if first_known:
+        # the first stage as a previous step would have left it
+        advance_general(p, ms, y0, k, tau, 0.5 * h, dt, ax, ay, has_ay, 1.0, 1.0, y1a, st_a,
+                        ytmp, w7a, False)
+        for i in range(n):
+            st_b[0, i] = st_a[0, i]
+    err_a = advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, 1.0, 1.0, y1a, st_a, ytmp, w7a,
+                    first_known, rtol, atol)
+    advance_general(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, 1.0, 1.0, y1b, st_b, ytmp, w7b,
+                    first_known)
+    err_b = error_norm(y0, y1b, st_b, h, rtol, atol)
+    return y1a, y1b, st_a[0].copy(), st_b[0].copy(), st_a[6].copy(), st_b[6].copy(), w7a, w7b, \
+        err_a, err_b
+
+
+@pytest.mark.parametrize("first_known", [False, True])
+def test_mode_3_step_equals_general_step(first_known):
+    """Same state, rates, forces and error norm to rounding, in small and large rotations."""
+    rng = np.random.default_rng(11)
+    n_large = 0
+    for trial in range(300):
+        system = _random_system(rng)
+        p = system.to_parameter_vector()
+        s = float(rng.choice([-1.0, 1.0]))
+        dt = float(rng.choice([0.005, 0.01, 0.02]))
+        ax = rng.uniform(-8.0, 8.0, 4)
+        ay = rng.uniform(-3.0, 3.0, 4)
+        has_ay = bool(trial % 2)
+        y0 = np.zeros(N_STATE)
+        y0[Y_TH] = s * rng.uniform(0.0, 0.9 * system.critical_angle)
+        # angular velocities up to 40 rad/s: stages beyond SMALL_ANGLE take their own sine
+        om_max = 40.0 if trial % 3 == 0 else 3.0
+        y0[Y_OM] = rng.uniform(-om_max, om_max)
+        y0[Y_WIN] = rng.uniform(0.0, 1e5)
+        y0[0] = rng.uniform(-0.1, 0.1)  # slip displacements ride along unchanged
+        y0[2] = rng.uniform(-0.1, 0.1)
+        ms = np.zeros(6, np.int64)
+        ms[MS_ROCK] = 1
+        ms[MS_S] = int(s)
+        ms[MS_SIG1] = 1
+        ms[MS_SIG2] = -1
+        tau = rng.uniform(0.0, 0.5) * dt
+        h = rng.uniform(0.01, 1.0) * (dt - tau)
+        n_large += abs(y0[Y_OM]) * h > SMALL_ANGLE
+        y1a, y1b, s0a, s0b, s6a, s6b, w7a, w7b, err_a, err_b = _both_steps(
+            p, ms, y0, 1, tau, h, dt, ax, ay, has_ay, first_known, 1e-8, 1e-10)
+        scale = np.abs(y1b) + np.abs(y0) + 1e-12
+        assert np.all(np.abs(y1a - y1b) <= 1e-13 * scale)
+        for ra, rb in ((s0a, s0b), (s6a, s6b)):
+            assert np.all(np.abs(ra - rb) <= 1e-12 * (np.abs(rb) + np.abs(rb).max() * 1e-3
+                                                      + 1e-12))
+        fscale = (p[P_M] + p[P_NM]) * (p[P_G] + 10.0)
+        for i in (I_FX, I_FY, I_SFX, I_SFY):
+            assert abs(w7a[i] - w7b[i]) <= 1e-12 * fscale
+        # the error estimate is a small difference of stage sums: agreement to its own
+        # rounding, i.e. relative to the sum's terms, not to the estimate
+        assert abs(err_a - err_b) <= 1e-6 * max(err_b, 1e-3 * (1 + err_b))
+    assert n_large > 10  # the large-rotation branch was exercised
