@@ -115,11 +115,13 @@ def active_window(time, acc, events=(), margin=2.0, end=None):
 
 #: Slip starts and stops are drawn as lines only up to this many (see :func:`plot_response`).
 MAX_SLIP_EVENT_LINES = 40
+#: Impacts likewise (a rocking episode has hundreds, mostly in its Zeno sequences).
+MAX_IMPACT_LINES = 40
 
 SLIP_EVENTS = ("ground_slip_start", "ground_slip_stop", "ship_slip_start", "ship_slip_stop")
 
 
-def plot_response(result, axes=None, max_event_lines=400, window="auto",
+def plot_response(result, axes=None, max_event_lines=MAX_IMPACT_LINES, window="auto",
                   max_slip_event_lines=MAX_SLIP_EVENT_LINES):
     """Response history: ground acceleration, block slip, rotation, ship slip, modes, events.
 
@@ -130,7 +132,9 @@ def plot_response(result, axes=None, max_event_lines=400, window="auto",
     axes : sequence of 4 matplotlib Axes, optional
         Panels for ground acceleration, x_b, theta and x_s; a new figure when None.
     max_event_lines : int, optional
-        Draw at most this many impact lines (dense Zeno sequences are thinned).
+        Draw impacts as lines only if there are at most this many: a rocking episode has
+        hundreds (mostly in the Zeno sequences that end it), whose lines would hide the curves;
+        the rotation's zero crossings show them as well (the legend gives their number).
     max_slip_event_lines : int, optional
         Draw slip starts and stops as lines only if there are at most this many: a stick-slip
         record has hundreds, whose lines would hide the curves, and the mode bands show the
@@ -186,8 +190,8 @@ def plot_response(result, axes=None, max_event_lines=400, window="auto",
         seen.add(m)
     # events
     impacts = [e for e in result.events if e.kind == "impact"]
-    stride = max(1, len(impacts) // max_event_lines)
-    for e in impacts[::stride]:
+    draw_impacts = len(impacts) <= max_event_lines
+    for e in impacts if draw_impacts else ():
         for ax in axes[1:4]:
             ax.axvline(e.time, **EVENT_STYLES["impact"], zorder=1)
     n_slip = sum(e.kind in SLIP_EVENTS for e in result.events)
@@ -211,6 +215,10 @@ def plot_response(result, axes=None, max_event_lines=400, window="auto",
         kinds -= set(SLIP_EVENTS)
         handles.append(Patch(facecolor="none", edgecolor="none",
                              label=f"{n_slip} slip starts and stops: see the mode bands"))
+    if not draw_impacts:
+        kinds.discard("impact")
+        handles.append(Patch(facecolor="none", edgecolor="none",
+                             label=f"{len(impacts)} impacts: see the zero crossings of theta"))
     handles += [Line2D([], [], **EVENT_STYLES[k], label=k.replace("_", " ")) for k in sorted(kinds)
                 if k in EVENT_STYLES]
     if handles:

@@ -161,6 +161,40 @@ def test_response_figure_draws_slip_lines_only_when_few():
     assert vertical_lines(few) == 3 * n_slip  # one line per event in each of three panels
 
 
+def test_response_figure_draws_impact_lines_only_when_few():
+    """A rocking episode has hundreds of impacts: beyond the limit they are counted in the
+    legend instead of drawn (their lines made the panels grey); below it each is a line."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import numpy as np
+
+    from shipblock import ShipBlockSystem, simulate
+    from shipblock.plot import EVENT_STYLES, MAX_IMPACT_LINES, plot_response
+
+    t = np.arange(0, 6, 0.005)
+    system = ShipBlockSystem(ship_mass=5e6, block_mass=1500.0, n_blocks=150, half_width=0.12,
+                             half_height=0.8, mu_s_ground=0.8, mu_k_ground=0.8, mu_s_ship=0.8,
+                             mu_k_ship=0.8)
+    ax = np.where(t < 1.0, 1.6 * np.sin(2 * np.pi * 1.0 * t), 0.0)  # rocks, about 300 impacts
+    res = simulate(system, ax, None, 0.005)
+    n_imp = sum(e.kind == "impact" for e in res.events)
+    assert n_imp > MAX_IMPACT_LINES
+
+    def vertical_lines(axes):
+        return sum(len([ln for ln in a.get_lines() if len(set(ln.get_xdata())) == 1])
+                   for a in axes[1:4])
+
+    n_other = sum(e.kind in EVENT_STYLES and e.kind != "impact" for e in res.events)
+    many = plot_response(res)
+    assert vertical_lines(many) == 3 * n_other
+    labels = [txt.get_text() for txt in many[3].get_legend().get_texts()]
+    assert f"{n_imp} impacts: see the zero crossings of theta" in labels
+    assert "impact" not in labels
+    few = plot_response(res, max_event_lines=n_imp)
+    assert vertical_lines(few) == 3 * (n_imp + n_other)
+
+
 def test_run_says_why_a_limit_state_was_not_fitted(tmp_path, capsys):
     """A limit state whose fit failed (e.g. beta not identified) is reported with the reason
     kept in the dataset's fit_error, never as a 'nan' median."""
