@@ -161,11 +161,13 @@ def simulate(
     if initial_state is not None:
         y_init = np.asarray(initial_state, dtype=float)
         if y_init.shape != (6,) or not np.isfinite(y_init).all():
-            raise ParameterError("initial_state must be 6 finite numbers (x_b, theta, x_s, v_b, "
-                             f"theta_dot, v_s), got {initial_state!r}")
+            raise ParameterError(
+                f"initial_state must be 6 finite numbers (x_b, theta, x_s, v_b, theta_dot, v_s), got {initial_state!r}"
+            )
         if abs(y_init[1]) >= system.critical_angle:
-            raise ParameterError(f"initial_state theta={y_init[1]} is beyond the critical angle "
-                             f"{system.critical_angle:.6g} rad")
+            raise ParameterError(
+                f"initial_state theta={y_init[1]} is beyond the critical angle {system.critical_angle:.6g} rad"
+            )
     p = system.to_parameter_vector()
     n = ax.size
     hist = np.empty((K.N_HIST, n))  # one contiguous row per history
@@ -177,8 +179,25 @@ def simulate(
     while True:
         ev_t = np.empty(log_size)
         ev_kft = np.empty((3, log_size), dtype=np.int64)
-        K.run(p, ax, ay_arr, has_ay, 1.0, 1.0, float(dt), rtol, atol, zeno_omega, True, hist,
-              modes, ev_t, ev_kft, summary, y_init)
+        K.run(
+            p,
+            ax,
+            ay_arr,
+            has_ay,
+            1.0,
+            1.0,
+            float(dt),
+            rtol,
+            atol,
+            zeno_omega,
+            True,
+            hist,
+            modes,
+            ev_t,
+            ev_kft,
+            summary,
+            y_init,
+        )
         n_ev = int(summary[K.S_N_EVENTS])
         if n_ev <= log_size:
             break
@@ -326,12 +345,7 @@ def simulate_batch(
         raise ParameterError("a case refers to a record index out of range")
     if par_idx.min(initial=0) < 0 or par_idx.max(initial=0) >= len(params):
         raise ParameterError("a case refers to a system index out of range")
-    # numba splits the case range into one contiguous block per thread; dealing the cases out
-    # round-robin first keeps the blocks alike when costs trend along the list (rising scale
-    # factors in an IDA, heavier records at the end), so no thread is left with the heavy end
-    n_threads = numba.get_num_threads()
-    order = np.argsort(np.arange(cases.shape[0]) % n_threads, kind="stable")
-    dealt = np.empty((cases.shape[0], K.N_SUMMARY))
+    summaries = np.empty((cases.shape[0], K.N_SUMMARY))
     K.run_many(
         params,
         acc_h,
@@ -339,18 +353,19 @@ def simulate_batch(
         offsets,
         dts_arr,
         np.array(has_v),
-        rec_idx[order],
-        par_idx[order],
-        np.ascontiguousarray(cases[order, 2]),
-        np.ascontiguousarray(cases[order, 3]),
+        rec_idx,
+        par_idx,
+        np.ascontiguousarray(cases[:, 2]),
+        np.ascontiguousarray(cases[:, 3]),
         rtol,
         atol,
         zeno_omega,
-        dealt,
+        numba.get_num_threads(),
+        np.zeros(1, dtype=np.int64),
+        summaries,
     )
     # one field per row, each row contiguous: the arrays returned are views of one block
-    by_field = np.empty((K.N_SUMMARY, cases.shape[0]))
-    by_field[:, order] = dealt.T
+    by_field = np.ascontiguousarray(summaries.T)
     out = {name: by_field[i] for name, i in SUMMARY_FIELDS.items()}
     for m, name in enumerate(MODE_TIME_FIELDS):
         out[name] = by_field[K.S_MODE_TIME + m]

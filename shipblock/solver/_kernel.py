@@ -115,6 +115,7 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     parameter_tuple,
 )
 from shipblock.solver._stuck_rocking import advance_stuck
+from shipblock.solver._workqueue import claim_next
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
 
@@ -932,11 +933,16 @@ def store_sample(p, ms, y, hist, modes, k, failed):
 
 @njit(cache=True, parallel=True)
 def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
-             case_sv, rtol, atol, zeno_omega, summaries):
+             case_sv, rtol, atol, zeno_omega, n_workers, next_case, summaries):
     """Run many cases in parallel; each case is (record, parameter row, H scale, V scale).
 
     Records are concatenated in ``acc_h``/``acc_v``; record ``r`` occupies
-    ``offsets[r]:offsets[r+1]``. Only summaries are produced.
+    ``offsets[r]:offsets[r+1]``. Only summaries are produced. Each of ``n_workers`` workers
+    (one per thread) claims the next unclaimed case from the counter ``next_case`` (int64,
+    length 1, zero on entry) until none is left, so uneven case costs do not idle a thread.
+    The caller owns both: numba's ``get_num_threads`` in compiled code would keep this
+    function out of the on-disk cache, and the counter must live outside the compiled
+    function, whose optimiser does not see the atomic writes to an array it allocated.
     """
     n_cases = case_record.shape[0]
     empty_hist = np.zeros((N_HIST, 0))
@@ -946,10 +952,14 @@ def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params
     at_rest = np.zeros(N_DYN)
     # a run-time False: a literal would make numba compile ``run`` a second time for it
     store = n_cases < 0
-    for c in prange(n_cases):
-        r = case_record[c]
-        a0 = offsets[r]
-        a1 = offsets[r + 1]
-        run(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
-            case_sv[c], dts[r], rtol, atol, zeno_omega, store, empty_hist, empty_modes, empty_t,
-            empty_kft, summaries[c], at_rest)
+    for _ in prange(min(n_workers, n_cases)):
+        while True:
+            c = claim_next(next_case)
+            if c >= n_cases:
+                break
+            r = case_record[c]
+            a0 = offsets[r]
+            a1 = offsets[r + 1]
+            run(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
+                case_sv[c], dts[r], rtol, atol, zeno_omega, store, empty_hist, empty_modes,
+                empty_t, empty_kft, summaries[c], at_rest)
