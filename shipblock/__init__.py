@@ -18,7 +18,7 @@ except PackageNotFoundError:  # running from a source tree that is not installed
 
 from shipblock.modes import EventKind, Failure, Mode
 from shipblock.result import Energy, Event, SimulationResult
-from shipblock.solver import simulate, simulate_batch
+from shipblock.solver import RecordSet, simulate, simulate_batch
 from shipblock.system import ShipBlockSystem, system_restitution
 
 # Heavier parts load on first use (obspy, xarray, scipy.stats).
@@ -52,6 +52,7 @@ __all__ = [
     "ShipBlockSystem",
     "simulate",
     "simulate_batch",
+    "RecordSet",
     "SimulationResult",
     "Event",
     "Energy",

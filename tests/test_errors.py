@@ -4,7 +4,7 @@ and they stay ValueErrors for code that expects the conventional type."""
 import numpy as np
 import pytest
 
-from shipblock import ShipBlockSystem, intensity, scaling, simulate, simulate_batch
+from shipblock import RecordSet, ShipBlockSystem, intensity, scaling, simulate, simulate_batch
 from shipblock.errors import ParameterError, RecordError, ShipblockError
 from shipblock.fragility.design import AnalysisDesign, IntensityDesign
 from shipblock.fragility.fit import fit_mle
@@ -40,6 +40,15 @@ CASES = {
     "batch NaN": (lambda: simulate_batch(ShipBlockSystem.example(),
                                          [(ACC, None), (ACC, np.r_[ACC[:-1], np.inf])], 0.01,
                                          [[0, 0, 1.0, 1.0]]), "records[1] vertical"),
+    "batch dt of one record": (lambda: simulate_batch(ShipBlockSystem.example(),
+                                                      [(ACC, None), (ACC, None)], [0.01, 0.0],
+                                                      [[0, 0, 1.0, 1.0]]), "record 1"),
+    "packed H/V lengths": (lambda: RecordSet([(ACC, ACC[:-1])], 0.01), "records[0]"),
+    "packed records and dts": (lambda: simulate_batch(ShipBlockSystem.example(),
+                                                      RecordSet([(ACC, None)], 0.01), 0.01,
+                                                      [[0, 0, 1.0, 1.0]]), "dts"),
+    "batch without dts": (lambda: simulate_batch(ShipBlockSystem.example(), [(ACC, None)],
+                                                 cases=[[0, 0, 1.0, 1.0]]), "dts"),
 }
 
 

@@ -4,7 +4,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from shipblock import ShipBlockSystem, simulate_batch
+from shipblock import RecordSet, ShipBlockSystem, simulate_batch
 from shipblock.solver._workqueue import claim_next
 
 
@@ -60,3 +60,17 @@ def test_batch_results_do_not_depend_on_threads_or_case_order():
     for key, values in serial.items():
         np.testing.assert_array_equal(parallel[key], values, err_msg=key)
         np.testing.assert_array_equal(shuffled[key], values[order], err_msg=key)
+
+
+def test_packed_records_give_the_same_results():
+    """A RecordSet packed once gives what the list of records gives, call after call."""
+    system, records, dt, cases = _uneven_batch()
+    records = records + [(records[0][0][::-1].copy(), None)]
+    cases = np.vstack([cases, [1, 0, 0.8, 0.0]])
+    listed = simulate_batch(system, records, dt, cases)
+    packed = RecordSet(records, dt)
+    assert len(packed) == 2 and packed.has_v.tolist() == [True, False]
+    for _ in range(2):
+        again = simulate_batch(system, packed, cases=cases)
+        for key, values in listed.items():
+            np.testing.assert_array_equal(again[key], values, err_msg=key)

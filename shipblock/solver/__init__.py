@@ -7,7 +7,6 @@ returns their summaries.
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Sequence
 
@@ -17,6 +16,7 @@ import numpy as np
 from shipblock.errors import ParameterError
 from shipblock.result import Energy, EventLog, SimulationResult, failure_name
 from shipblock.solver import _kernel as K
+from shipblock.solver._inputs import RecordSet, as_acceleration, check_dt, check_options
 from shipblock.system import P_THC, ShipBlockSystem
 
 #: Default relative tolerance of the rocking integration [-].
@@ -47,35 +47,6 @@ SUMMARY_FIELDS = {
     "final_energy": K.S_ENERGY_FINAL,
 }
 MODE_TIME_FIELDS = [f"time_in_mode_{m}" for m in range(1, 9)]
-
-
-def _as_acceleration(values, name: str, check_finite: bool = True) -> np.ndarray:
-    arr = np.asarray(values, dtype=float)
-    if arr.ndim != 1:
-        raise ParameterError(f"{name} must be a one-dimensional array, got shape {arr.shape}")
-    if arr.size < 2:
-        raise ParameterError(f"{name} must have at least 2 samples, got {arr.size}")
-    if check_finite:
-        _check_finite(arr, name)
-    return np.ascontiguousarray(arr)
-
-
-def _check_finite(arr: np.ndarray, name: str) -> None:
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        raise ParameterError(f"{name} has {int(bad.sum())} non-finite samples (first at index {i})")
-
-
-def _check_options(dt, rtol, atol, zeno_omega):
-    if not (isinstance(dt, int | float | np.floating) and math.isfinite(dt) and dt > 0):
-        raise ParameterError(f"dt must be a finite number > 0 [s], got {dt!r}")
-    if not (0 < rtol < 1):
-        raise ParameterError(f"rtol must lie in (0, 1), got {rtol!r}")
-    if not (atol > 0):
-        raise ParameterError(f"atol must be > 0, got {atol!r}")
-    if not (zeno_omega >= 0):
-        raise ParameterError(f"zeno_omega must be >= 0 [rad/s], got {zeno_omega!r}")
 
 
 def simulate(
@@ -147,13 +118,14 @@ def simulate(
         raise ParameterError("dt [s] is required when ax is an array")
     if not isinstance(system, ShipBlockSystem):
         raise TypeError(f"system must be a ShipBlockSystem, got {type(system).__name__}")
-    _check_options(dt, rtol, atol, zeno_omega)
-    ax = _as_acceleration(ax, "ax")
+    check_dt(dt)
+    check_options(rtol, atol, zeno_omega)
+    ax = as_acceleration(ax, "ax")
     if ay is None:
         ay_arr = ax  # a stand-in the kernel never reads (has_ay False): no zeros to allocate
         has_ay = False
     else:
-        ay_arr = _as_acceleration(ay, "ay")
+        ay_arr = as_acceleration(ay, "ay")
         if ay_arr.size != ax.size:
             raise ParameterError(f"ax and ay must have the same length, got {ax.size} and {ay_arr.size}")
         has_ay = True
@@ -260,9 +232,9 @@ def _summary_dict(summary: np.ndarray, system: ShipBlockSystem) -> dict:
 
 def simulate_batch(
     systems: ShipBlockSystem | Sequence[ShipBlockSystem],
-    records: Sequence,
-    dts: Sequence[float] | float,
-    cases,
+    records: Sequence | RecordSet,
+    dts: Sequence[float] | float | None = None,
+    cases=None,
     *,
     rtol: float = DEFAULT_RTOL,
     atol: float = DEFAULT_ATOL,
@@ -270,14 +242,20 @@ def simulate_batch(
 ) -> dict:
     """Run many cases in one compiled call, in parallel over the available cores.
 
+    The cases are shared out dynamically: each thread takes the next case not yet started,
+    so cases of very different cost (early failure, long rocking) keep all threads busy.
+    Results do not depend on the number of threads or on the order of the cases.
+
     Parameters
     ----------
     systems : ShipBlockSystem or sequence of ShipBlockSystem
         The systems; cases refer to them by index.
-    records : sequence of (ax, ay)
-        Ground motions [m/s^2]; ``ay`` may be None.
-    dts : float or sequence of float
-        Sample interval of each record [s].
+    records : sequence of (ax, ay), or RecordSet
+        Ground motions [m/s^2]; ``ay`` may be None. A :class:`RecordSet` (the records checked
+        and packed once) saves that work in repeated calls on the same records.
+    dts : float or sequence of float, optional
+        Sample interval of each record [s]; required with a sequence of records, not given
+        with a :class:`RecordSet` (which holds its own).
     cases : array_like, shape (n_cases, 4)
         Rows ``(record_index, system_index, scale_h, scale_v)``.
     rtol, atol, zeno_omega : float, optional
@@ -292,50 +270,18 @@ def simulate_batch(
     if isinstance(systems, ShipBlockSystem):
         systems = [systems]
     params = np.array([s.to_parameter_vector() for s in systems])
-    n_rec = len(records)
-    if np.isscalar(dts):
-        dts = [dts] * n_rec
-    dts_arr = np.asarray(dts, dtype=float)
-    if dts_arr.shape != (n_rec,):
-        raise ParameterError(f"dts must give one sample interval per record ({n_rec})")
-    checked = set()
-    for i, d in enumerate(dts_arr.tolist()):
-        if d in checked:
-            continue
-        try:
-            _check_options(d, rtol, atol, zeno_omega)
-        except ValueError as exc:
-            raise ParameterError(f"record {i}: {exc}") from None
-        checked.add(d)
-    hs, vs, has_v = [], [], []
-    for i, (h, v) in enumerate(records):
-        # finiteness is checked below on all records at once (one pass, not one per record)
-        h = _as_acceleration(h, f"records[{i}] horizontal", check_finite=False)
-        hs.append(h)
-        if v is None:
-            vs.append(h)  # a stand-in the kernel never reads (has_v False)
-            has_v.append(False)
-        else:
-            v = _as_acceleration(v, f"records[{i}] vertical", check_finite=False)
-            if v.size != h.size:
-                raise ParameterError(f"records[{i}]: horizontal and vertical lengths differ")
-            vs.append(v)
-            has_v.append(True)
-    offsets = np.zeros(n_rec + 1, dtype=np.int64)
-    offsets[1:] = np.cumsum([h.size for h in hs])
-    acc_h = np.concatenate(hs)
-    # without any vertical component the horizontal stands in (never read): a second array of
-    # the records' size costs page faults out of proportion to a batch of short records
-    acc_v = np.concatenate(vs) if any(has_v) else acc_h
-    with np.errstate(over="ignore", invalid="ignore"):
-        total = np.add.reduce(acc_h) + (np.add.reduce(acc_v) if any(has_v) else 0.0)
-    if not math.isfinite(total):
-        # a NaN or infinity makes the sum non-finite (so may an overflow of finite samples):
-        # find the record and sample to name
-        for i, (h, v) in enumerate(zip(hs, vs, strict=True)):
-            _check_finite(h, f"records[{i}] horizontal")
-            if has_v[i]:
-                _check_finite(v, f"records[{i}] vertical")
+    check_options(rtol, atol, zeno_omega)
+    if isinstance(records, RecordSet):
+        if dts is not None:
+            raise ParameterError("dts must not be given with a RecordSet: it holds the records' own")
+        packed = records
+    else:
+        if dts is None:
+            raise ParameterError("dts (the records' sample intervals [s]) is required")
+        packed = RecordSet(records, dts)
+    if cases is None:
+        raise ParameterError("cases is required: rows (record, system, scale_h, scale_v)")
+    n_rec = len(packed)
     cases = np.asarray(cases, dtype=float)
     if cases.ndim != 2 or cases.shape[1] != 4:
         raise ParameterError("cases must have shape (n_cases, 4): record, system, scale_h, scale_v")
@@ -348,11 +294,11 @@ def simulate_batch(
     summaries = np.empty((cases.shape[0], K.N_SUMMARY))
     K.run_many(
         params,
-        acc_h,
-        acc_v,
-        offsets,
-        dts_arr,
-        np.array(has_v),
+        packed.acc_h,
+        packed.acc_v,
+        packed.offsets,
+        packed.dts,
+        packed.has_v,
         rec_idx,
         par_idx,
         np.ascontiguousarray(cases[:, 2]),
@@ -374,4 +320,4 @@ def simulate_batch(
     return out
 
 
-__all__ = ["simulate", "simulate_batch", "SUMMARY_FIELDS", "MODE_TIME_FIELDS"]
+__all__ = ["simulate", "simulate_batch", "RecordSet", "SUMMARY_FIELDS", "MODE_TIME_FIELDS"]
