@@ -138,42 +138,38 @@ def solve_mode_at(p, slip1, rock, slip2, s, sig1, sig2, c, sn, omega, a, G, out)
     fxs = M
     fy0 = nm * (G - Rc * w2) + Fy0
     fyt = nm * Rss + Fyt
-    if rock and not slip1 and not slip2:
-        # Rocking on two stuck interfaces, the common rocking mode: rows 0 and 2 below are
-        # unit rows, and Cramer's rule reduces to u1 = b1 / a11 with the same singularity test
-        # (det = a11, scale = the largest entry of row 1). The terms skipped are products with
-        # exact zeros, so the results equal those of the general solve.
-        a10 = -Rc * (fxb + Fxb)
-        a11 = p[P_NI] - Rc * (fxt + Fxt) + Rss * (fyt + Fyt)
-        a12 = -Rc * (fxs + Fxs)
-        b1 = Rc * (fx0 + Fx0) - Rss * (fy0 + Fy0)
-        if not abs(a11) > SINGULAR_RELATIVE * max(abs(a10), abs(a11), abs(a12)):
-            for i in range(N_SOLVE_OUT):
-                out[i] = np.nan
-            return False
-        u1 = b1 / a11
-        out[I_XB_DD] = 0.0
-        out[I_TH_DD] = u1
-        out[I_XS_DD] = 0.0
-        out[I_FX] = fx0 + fxt * u1
-        out[I_FY] = fy0 + fyt * u1
-        out[I_SFX] = Fx0 + Fxt * u1
-        out[I_SFY] = Fy0 + Fyt * u1
-        return True
-    # Row 0: ground interface.
-    if slip1:
-        mu = sig1 * p[P_MUK1]
-        a00, a01, a02, b0 = fxb, fxt + mu * fyt, fxs, -(fx0 + mu * fy0)
-    else:
-        a00, a01, a02, b0 = 1.0, 0.0, 0.0, 0.0
     # Row 1: rocking moment about the block centroid.
     if rock:
         a10 = -Rc * (fxb + Fxb)
         a11 = p[P_NI] - Rc * (fxt + Fxt) + Rss * (fyt + Fyt)
         a12 = -Rc * (fxs + Fxs)
         b1 = Rc * (fx0 + Fx0) - Rss * (fy0 + Fy0)
+        if not slip1 and not slip2:
+            # Rocking on two stuck interfaces, the common rocking mode: rows 0 and 2 are unit
+            # rows, and Cramer's rule reduces to u1 = b1 / a11 with the same singularity test
+            # (det = a11, scale = the largest entry of row 1). The terms skipped are products
+            # with exact zeros, so the results equal those of the general solve.
+            if not abs(a11) > SINGULAR_RELATIVE * max(abs(a10), abs(a11), abs(a12)):
+                for i in range(N_SOLVE_OUT):
+                    out[i] = np.nan
+                return False
+            u1 = b1 / a11
+            out[I_XB_DD] = 0.0
+            out[I_TH_DD] = u1
+            out[I_XS_DD] = 0.0
+            out[I_FX] = fx0 + fxt * u1
+            out[I_FY] = fy0 + fyt * u1
+            out[I_SFX] = Fx0 + Fxt * u1
+            out[I_SFY] = Fy0 + Fyt * u1
+            return True
     else:
         a10, a11, a12, b1 = 0.0, 1.0, 0.0, 0.0
+    # Row 0: ground interface.
+    if slip1:
+        mu = sig1 * p[P_MUK1]
+        a00, a01, a02, b0 = fxb, fxt + mu * fyt, fxs, -(fx0 + mu * fy0)
+    else:
+        a00, a01, a02, b0 = 1.0, 0.0, 0.0, 0.0
     # Row 2: ship interface.
     if slip2:
         mu = sig2 * p[P_MUK2]
