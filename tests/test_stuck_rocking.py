@@ -39,7 +39,13 @@ from shipblock.solver._layout import (
     Y_WIN,
     parameter_tuple,
 )
-from shipblock.solver._stuck_rocking import SMALL_ANGLE, small_angle_sincos
+from shipblock.solver._fused import fma
+from shipblock.solver._stuck_rocking import (
+    SHORT_ANGLE,
+    SMALL_ANGLE,
+    short_angle_sincos,
+    small_angle_sincos,
+)
 from shipblock.system import P_G, P_M, P_NM, P_R, P_THC
 
 try:  # tests/ as a package or as a plain directory
@@ -94,6 +100,28 @@ def test_small_angle_sincos():
         sn, cs = small_angle_sincos(x)
         assert abs(sn - math.sin(x)) <= 2.5e-16 * max(abs(x), 1e-300) + 1e-300
         assert abs(cs - math.cos(x)) <= 2.5e-16
+
+
+def test_short_angle_sincos():
+    """The short series of the usual step agrees with the library to rounding."""
+    for x in np.linspace(-SHORT_ANGLE, SHORT_ANGLE, 20001):
+        sn, cs = short_angle_sincos(x)
+        assert abs(sn - math.sin(x)) <= 2.5e-16 * max(abs(x), 1e-300) + 1e-300
+        assert abs(cs - math.cos(x)) <= 1.2e-16
+
+
+@njit
+def _fma(a, b, c):
+    return fma(a, b, c)
+
+
+def test_fma_rounds_once():
+    """0.1 * 10 - 1 is 0 with two roundings and the exact 2**-54 with one."""
+    assert 0.1 * 10.0 - 1.0 == 0.0
+    assert _fma(0.1, 10.0, -1.0) == 2.0**-54
+    x = 1.0 + 2.0**-30
+    assert _fma(x, x, -(x * x)) == 2.0**-60  # the square's rounding error, exactly
+    assert _fma(2.0, 3.0, 1.0) == 7.0
 
 
 @njit

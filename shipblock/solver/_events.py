@@ -34,6 +34,14 @@ from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R, P_TH
 
 
 @njit(cache=True, inline="always")
+def rotation_event(p, ms, e, theta):
+    """The event functions that depend on the rotation alone: impact and overturning."""
+    if e == EV_IMPACT:
+        return ms[MS_S] * theta
+    return p[P_THC] - ms[MS_S] * theta
+
+
+@njit(cache=True, inline="always")
 def event_functions(p, ms, y, fx, fy, Fx, Fy, g):
     """Fill ``g`` with the event functions of mode ``ms`` at state ``y`` and interface forces.
 
@@ -49,8 +57,8 @@ def event_functions(p, ms, y, fx, fy, Fx, Fy, g):
     else:
         g[EV_G_STICK] = (p[P_MUS1] * fy - abs(fx)) / weight
     if ms[MS_ROCK]:
-        g[EV_IMPACT] = ms[MS_S] * y[Y_TH]
-        g[EV_OVERTURN] = p[P_THC] - ms[MS_S] * y[Y_TH]
+        g[EV_IMPACT] = rotation_event(p, ms, EV_IMPACT, y[Y_TH])
+        g[EV_OVERTURN] = rotation_event(p, ms, EV_OVERTURN, y[Y_TH])
     else:
         g[EV_UPLIFT] = (p[P_B] * (fy + Fy) - p[P_H] * abs(fx + Fx)) / (weight * p[P_R])
     if ms[MS_SLIP2]:

@@ -135,3 +135,24 @@ def hermite_extremum(g0, d0, g1, d1):
         u = best_u
         best_v = g0 + d0 * u + c2 * u * u + c3 * u * u * u
     return best_u, best_v
+
+
+@njit(cache=True)
+def rotation_extremum(th0, om0, al0, th1, om1, al1, h):
+    """Peak |theta| inside a rocking step in which theta_dot changes sign, and its time.
+
+    Read off the quintic Hermite interpolant of the step (no further integration), so peak
+    rotations and their times do not depend on where the steps happen to end.
+
+    Returns
+    -------
+    peak : float
+        |theta| at the extremum [rad].
+    s : float
+        Its time after the start of the step [s].
+    """
+    c0, c1, c2, c3, c4, c5 = quintic_hermite(th0, om0, al0, th1, om1, al1, h)
+    u = bracketed_root(c0, c1, c2, c3, c4, c5, 0.0, 1.0, True)
+    if u < 0.0:
+        return max(abs(th0), abs(th1)), 0.0
+    return abs(poly5(c0, c1, c2, c3, c4, c5, u)), u * h

@@ -40,13 +40,13 @@ from shipblock.impact import apply_impact
 from shipblock.modes import MODE_NUMBER, EventKind, Failure
 from shipblock.solver._closed_form import nonrocking_span
 from shipblock.solver._dopri import DP_A, DP_C, DP_E, DP_ERROR_ORDER
-from shipblock.solver._events import event_functions
+from shipblock.solver._events import event_functions, rotation_event
 from shipblock.solver._ground import ground_motion_at
 from shipblock.solver._interpolate import (
     bracketed_root,
     hermite_extremum,
-    poly5,
     quintic_hermite,
+    rotation_extremum,
 )
 from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrappers)
     ACC_TOL,
@@ -114,7 +114,7 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     Y_XS,
     parameter_tuple,
 )
-from shipblock.solver._stuck_rocking import advance_stuck
+from shipblock.solver._stuck_rocking import advance_stuck, stuck_rocking_span
 from shipblock.solver._workqueue import claim_next
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
@@ -262,12 +262,16 @@ def has_slope(e):
 def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g):
     """Event function ``e`` after advancing ``y0`` by ``h`` (state left in ``y1``).
 
-    Called only after a step from ``y0``, so ``stages[0]`` already holds f(t, y0).
+    Called only after a step from ``y0``, so ``stages[0]`` already holds f(t, y0). ``g`` gets
+    all event functions there, except for the events of the rotation alone (impact,
+    overturning), which need no forces.
     """
     advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, True, 1.0,
             1.0)
     if e == EV_ROTATION_PEAK:
         return y1[Y_OM] if y0[Y_OM] > 0.0 else -y1[Y_OM]
+    if e == EV_IMPACT or e == EV_OVERTURN:
+        return rotation_event(p, ms, e, y1[Y_TH])
     event_values(p, ms, y1, k, tau + h, dt, ax, ay, has_ay, sh, sv, g, w7)
     return g[e]
 
@@ -335,27 +339,6 @@ def mode_number_of(slip1, rock, slip2):
 def mode_number(ms):
     """Paper mode number (1..8) of a mode state vector."""
     return mode_number_of(ms[MS_SLIP1], ms[MS_ROCK], ms[MS_SLIP2])
-
-
-@njit(cache=True, _nrt=False)
-def rotation_extremum(y0, y1, al0, al1, h):
-    """Peak |theta| inside a rocking step in which theta_dot changes sign, and its time.
-
-    Read off the quintic Hermite interpolant of the step (no further integration), so peak
-    rotations and their times do not depend on where the steps happen to end.
-
-    Returns
-    -------
-    peak : float
-        |theta| at the extremum [rad].
-    s : float
-        Its time after the start of the step [s].
-    """
-    c0, c1, c2, c3, c4, c5 = quintic_hermite(y0[Y_TH], y0[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h)
-    u = bracketed_root(c0, c1, c2, c3, c4, c5, 0.0, 1.0, True)
-    if u < 0.0:
-        return max(abs(y0[Y_TH]), abs(y1[Y_TH])), 0.0
-    return abs(poly5(c0, c1, c2, c3, c4, c5, u)), u * h
 
 
 @njit(cache=True)
@@ -688,6 +671,20 @@ summary, y_init
                 failure_time = k * dt + tau
                 break
         else:
+            if (tau == 0.0 and h_rock >= dt and ms[MS_SLIP1] == 0 and ms[MS_SLIP2] == 0
+                    and y[Y_VB] == 0.0 and y[Y_VS] == 0.0):
+                # the usual rocking mode from a sample on: whole samples while nothing happens
+                k_before = k
+                k, span_time, peak_th, peak_th_time = stuck_rocking_span(
+                    p, ms, y, k, dt, ax, ay, has_ay, sh, sv, rtol, atol, armed, g0, g1, peak_th,
+                    peak_th_time, store, hist, modes, mode_number(ms))
+                if k != k_before:
+                    summary[S_MODE_TIME + mode_number(ms) - 1] += span_time
+                    events_here = 0
+                    fsal = False
+                    if k >= n - 1:
+                        break
+                # (the step the span stopped before is taken below)
             # rocking: error-controlled Dormand-Prince steps within the sample interval, where
             # the input is linear (a step across a sample would straddle a kink of the input)
             remaining = dt - tau
@@ -776,7 +773,8 @@ summary, y_init
             if best_e < 0:
                 # accept the whole step
                 if y[Y_OM] * y1[Y_OM] < 0.0:
-                    ext, s_ext = rotation_extremum(y, y1, al0, al1, h)
+                    ext, s_ext = rotation_extremum(y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM],
+                                                   al1, h)
                     if ext > peak_th:
                         peak_th = ext
                         peak_th_time = k * dt + tau + s_ext

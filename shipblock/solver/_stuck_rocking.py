@@ -33,17 +33,25 @@ from shipblock.equations import (
     I_TH_DD,
     I_XB_DD,
     I_XS_DD,
+    kinetic_energy,
+    potential_energy,
     stuck_rocking_forces,
     stuck_rocking_gain,
     stuck_rocking_rates,
 )
 from shipblock.solver._dopri import DP_A, DP_C, DP_E
+from shipblock.solver._events import event_functions
+from shipblock.solver._fused import fma
+from shipblock.solver._interpolate import rotation_extremum
 from shipblock.solver._layout import (
+    EV_IMPACT,
+    H_KIN,
+    H_POT,
     MS_S,
     N_DYN,
+    N_EVENTS,
     N_STATE,
-    Y_DIS,
-    Y_IMP,
+    REARM_TOL,
     Y_OM,
     Y_TH,
     Y_VB,
@@ -52,7 +60,7 @@ from shipblock.solver._layout import (
     Y_XB,
     Y_XS,
 )
-from shipblock.system import P_G, P_THC
+from shipblock.system import P_G, P_M, P_NM, P_R, P_THC
 
 #: Largest |delta| [rad] for the series of :func:`small_angle_sincos` (truncation below 1e-17
 #: relative); beyond it the stage takes its own sine and cosine.
@@ -80,19 +88,144 @@ def small_angle_sincos(d):
     return sn, cs
 
 
+#: Largest |delta| [rad] for the short series of :func:`short_angle_sincos` (truncation below
+#: 1e-18 relative): a step's rotation is almost always this small (|omega| h <= 0.02).
+SHORT_ANGLE = 0.02
+
+
 @njit(cache=True, inline="always")
-def _rates(p, gain, s, th0, c0, s0, d, om, a, ay):
-    """Stage rates (theta_dd, power) at theta0 + d; also the geometry ``(c, sn)`` there."""
-    if abs(d) <= SMALL_ANGLE:
-        sd, cd = small_angle_sincos(d)
-        c = c0 * cd + s * s0 * sd
-        sn = s0 * cd - s * c0 * sd
-    else:
-        phi = p[P_THC] - s * (th0 + d)
-        c = math.cos(phi)
-        sn = math.sin(phi)
-    al, pw = stuck_rocking_rates(p, gain, c, sn, s, om, a, ay)
-    return al, pw, c, sn
+def short_angle_sincos(d):
+    """``(sin d, cos d)`` by their Taylor series to degree 7 and 6, for ``|d| <= SHORT_ANGLE``."""
+    d2 = d * d
+    sn = fma(d * d2, fma(d2, fma(d2, -1.0 / 5040.0, 1.0 / 120.0), -1.0 / 6.0), d)
+    cs = fma(d2, fma(d2, fma(d2, -1.0 / 720.0, 1.0 / 24.0), -0.5), 1.0)
+    return sn, cs
+
+
+@njit(cache=True, inline="always")
+def turn(d):
+    """``(sin d, cos d)`` of a stage's rotation within a step: the shortest accurate way."""
+    ad = abs(d)
+    if ad <= SHORT_ANGLE:
+        return short_angle_sincos(d)
+    if ad <= SMALL_ANGLE:
+        return small_angle_sincos(d)
+    return math.sin(d), math.cos(d)
+
+
+@njit(cache=True, inline="always")
+def _turned(sd, cd, pr, qr, pp, qp, om):
+    """Stage rates (theta_dd, power) after a turn ``(sd, cd)``: see :func:`stuck_step`."""
+    return fma(cd, pr, sd * qr), om * fma(cd, pp, sd * qp)
+
+
+@njit(cache=True, inline="always")
+def _turn_coefficients(gain, kpow, s, c0, s0, a, ay, G):
+    """``(P, Q)`` of the rate and of the power at input ``(a, ay)``, ``G = g + ay``."""
+    sa = s * a
+    return (gain * (a * c0 - s * G * s0), gain * (sa * s0 + G * c0),
+            kpow * (a * c0 - s * ay * s0), kpow * (sa * s0 + ay * c0))
+
+
+@njit(cache=True, inline="always")
+def stuck_step(p, gain, s, c0, s0, th0, om0, w0, al1, pw1, a0, da, b0, db, f0, fh, h):
+    """One Dormand-Prince 5(4) step of ``h`` in mode 3, in scalars.
+
+    The geometry enters through its value ``(c0, s0)`` at the start of the step: at a rotation
+    :math:`\\delta` further, by the angle-addition formulas and :math:`s^2 = 1`, the rate and
+    the input power of :func:`~shipblock.equations.stuck_rocking_rates` are
+
+    .. math::
+
+        \\ddot\\theta = P\\cos\\delta + Q\\sin\\delta, \\qquad
+        P = k(c_0 a - s\\bar s_0 G), \\quad Q = k(s\\bar s_0 a + c_0 G),
+
+    (:math:`k` the gain; the power likewise with :math:`(nm + 2M)R\\dot\\theta` and
+    :math:`\\ddot y_g` for :math:`G`), so a stage's only work after its rotation is known is
+    :func:`turn` and two products: the chain of dependent operations from one stage to the
+    next is as short as the mode allows.
+
+    Parameters
+    ----------
+    p : tuple
+        Parameters.
+    gain, s : float
+        :func:`~shipblock.equations.stuck_rocking_gain` and the pivot sign.
+    c0, s0 : float
+        :func:`~shipblock.equations.pivot_geometry` at ``th0``.
+    th0, om0, w0 : float
+        Rotation, angular velocity and input work at the start.
+    al1, pw1 : float
+        Angular acceleration and input power at the start (the first stage).
+    a0, da, b0, db : float
+        The sample interval's horizontal and vertical input, ``a0 + da * f`` at ``f`` (the
+        fraction of the interval), already scaled.
+    f0, fh : float
+        Fraction of the interval at the start of the step, and the step's length in it.
+    h : float
+        Step [s].
+
+    Returns
+    -------
+    th1, om1, w1, al7, pw7, c7, sn7, e_th, e_om : float
+        The 5th-order solution, the rates and the geometry there (first same as last), and the
+        embedded error estimates of theta and theta_dot.
+    """
+    G0 = p[P_G] + b0
+    kpow = (p[P_NM] + 2.0 * p[P_M]) * p[P_R]
+    # the input at each stage, and its (P, Q) coefficients: off the chain of stages
+    f = f0 + C2 * fh
+    pr2, qr2, pp2, qp2 = _turn_coefficients(gain, kpow, s, c0, s0, a0 + da * f, b0 + db * f,
+                                            G0 + db * f)
+    f = f0 + C3 * fh
+    pr3, qr3, pp3, qp3 = _turn_coefficients(gain, kpow, s, c0, s0, a0 + da * f, b0 + db * f,
+                                            G0 + db * f)
+    f = f0 + C4 * fh
+    pr4, qr4, pp4, qp4 = _turn_coefficients(gain, kpow, s, c0, s0, a0 + da * f, b0 + db * f,
+                                            G0 + db * f)
+    f = f0 + C5 * fh
+    pr5, qr5, pp5, qp5 = _turn_coefficients(gain, kpow, s, c0, s0, a0 + da * f, b0 + db * f,
+                                            G0 + db * f)
+    f = f0 + fh
+    a_end = a0 + da * f
+    b_end = b0 + db * f
+    pr6, qr6, pp6, qp6 = _turn_coefficients(gain, kpow, s, c0, s0, a_end, b_end, G0 + db * f)
+    # each stage's sums end with a fused term: the newest rate, the only one just computed
+    om1 = om0
+    om2 = fma(h * A21, al1, om0)
+    sd, cd = turn(h * (A21 * om1))
+    al2, pw2 = _turned(sd, cd, pr2, qr2, pp2, qp2, om2)
+    om3 = fma(h * A32, al2, om0 + h * (A31 * al1))
+    sd, cd = turn(fma(h * A32, om2, h * (A31 * om1)))
+    al3, pw3 = _turned(sd, cd, pr3, qr3, pp3, qp3, om3)
+    om4 = fma(h * A43, al3, om0 + h * (A41 * al1 + A42 * al2))
+    sd, cd = turn(fma(h * A43, om3, h * (A41 * om1 + A42 * om2)))
+    al4, pw4 = _turned(sd, cd, pr4, qr4, pp4, qp4, om4)
+    om5 = fma(h * A54, al4, om0 + h * (A51 * al1 + A52 * al2 + A53 * al3))
+    sd, cd = turn(fma(h * A54, om4, h * (A51 * om1 + A52 * om2 + A53 * om3)))
+    al5, pw5 = _turned(sd, cd, pr5, qr5, pp5, qp5, om5)
+    om6 = fma(h * A65, al5, om0 + h * (A61 * al1 + A62 * al2 + A63 * al3 + A64 * al4))
+    sd, cd = turn(fma(h * A65, om5, h * (A61 * om1 + A62 * om2 + A63 * om3 + A64 * om4)))
+    al6, pw6 = _turned(sd, cd, pr6, qr6, pp6, qp6, om6)
+    # the 5th-order solution, and the rates there (first same as last)
+    d7 = fma(h * B6, om6, h * (B1 * om1 + B3 * om3 + B4 * om4 + B5 * om5))
+    om7 = fma(h * B6, al6, om0 + h * (B1 * al1 + B3 * al3 + B4 * al4 + B5 * al5))
+    w1 = w0 + h * (B1 * pw1 + B3 * pw3 + B4 * pw4 + B5 * pw5 + B6 * pw6)
+    sd, cd = turn(d7)
+    al7, pw7 = _turned(sd, cd, pr6, qr6, pp6, qp6, om7)
+    c7 = c0 * cd + s * s0 * sd
+    sn7 = s0 * cd - s * c0 * sd
+    e_th = h * (E1 * om1 + E3 * om3 + E4 * om4 + E5 * om5 + E6 * om6 + E7 * om7)
+    e_om = h * (E1 * al1 + E3 * al3 + E4 * al4 + E5 * al5 + E6 * al6 + E7 * al7)
+    return th0 + d7, om7, w1, al7, pw7, c7, sn7, e_th, e_om
+
+
+@njit(cache=True, inline="always")
+def stuck_error_norm(th0, om0, th1, om1, e_th, e_om, rtol, atol):
+    """The error norm of :func:`~shipblock.solver._kernel.error_norm` for a mode-3 step."""
+    sc_th = atol + rtol * max(abs(th0), abs(th1))
+    sc_om = atol + rtol * max(abs(om0), abs(om1))
+    return math.sqrt(((e_th / sc_th) ** 2 + (e_om / sc_om) ** 2) / N_DYN)
 
 
 @njit(cache=True, inline="always")
@@ -103,94 +236,173 @@ def advance_stuck(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, 
     The contract of :func:`~shipblock.solver._kernel.advance`: ``y1`` gets the 5th-order
     solution, ``stages[0]`` (if not known) and ``stages[6]`` the rates at both ends (the other
     stages are not stored), ``w7`` the accelerations and forces at the end of the step.
-    Requires no slip velocities in ``y0`` (mode 3 keeps them zero).
+    Requires no slip velocities in ``y0`` (mode 3 keeps them zero). The step itself is
+    :func:`stuck_step`.
     """
     s = float(ms[MS_S])
     gain = stuck_rocking_gain(p)
     a0 = sh * ax[k]
-    a1 = sh * ax[k + 1]
+    da = sh * ax[k + 1] - a0
     b0 = sv * ay[k] if has_ay else 0.0
-    b1 = sv * ay[k + 1] if has_ay else 0.0
-    da = a1 - a0
-    db = b1 - b0
+    db = (sv * ay[k + 1] if has_ay else 0.0) - b0
     th0 = y0[Y_TH]
     om0 = y0[Y_OM]
     phi0 = p[P_THC] - s * th0
     c0 = math.cos(phi0)
     s0 = math.sin(phi0)
+    f0 = tau / dt
     if first_stage_known:
         al1 = stages[0, Y_OM]
         pw1 = stages[0, Y_WIN]
     else:
-        f = tau / dt
-        al1, pw1 = stuck_rocking_rates(p, gain, c0, s0, s, om0, a0 + da * f, b0 + db * f)
-        for i in range(N_STATE):
-            stages[0, i] = 0.0
-        stages[0, Y_XB] = y0[Y_VB]
-        stages[0, Y_TH] = om0
-        stages[0, Y_XS] = y0[Y_VS]
-        stages[0, Y_OM] = al1
-        stages[0, Y_WIN] = pw1
-    om1 = om0
-    # stage 2
-    f = (tau + C2 * h) / dt
-    om2 = om0 + h * (A21 * al1)
-    al2, pw2, _, _ = _rates(p, gain, s, th0, c0, s0, h * (A21 * om1), om2,
-                            a0 + da * f, b0 + db * f)
-    # stage 3
-    f = (tau + C3 * h) / dt
-    om3 = om0 + h * (A31 * al1 + A32 * al2)
-    al3, pw3, _, _ = _rates(p, gain, s, th0, c0, s0, h * (A31 * om1 + A32 * om2), om3,
-                            a0 + da * f, b0 + db * f)
-    # stage 4
-    f = (tau + C4 * h) / dt
-    om4 = om0 + h * (A41 * al1 + A42 * al2 + A43 * al3)
-    al4, pw4, _, _ = _rates(p, gain, s, th0, c0, s0, h * (A41 * om1 + A42 * om2 + A43 * om3),
-                            om4, a0 + da * f, b0 + db * f)
-    # stage 5
-    f = (tau + C5 * h) / dt
-    om5 = om0 + h * (A51 * al1 + A52 * al2 + A53 * al3 + A54 * al4)
-    al5, pw5, _, _ = _rates(p, gain, s, th0, c0, s0,
-                            h * (A51 * om1 + A52 * om2 + A53 * om3 + A54 * om4), om5,
-                            a0 + da * f, b0 + db * f)
-    # stage 6 (at the end of the step)
-    f = (tau + h) / dt
-    om6 = om0 + h * (A61 * al1 + A62 * al2 + A63 * al3 + A64 * al4 + A65 * al5)
-    al6, pw6, _, _ = _rates(p, gain, s, th0, c0, s0,
-                            h * (A61 * om1 + A62 * om2 + A63 * om3 + A64 * om4 + A65 * om5),
-                            om6, a0 + da * f, b0 + db * f)
-    # the 5th-order solution, and the rates there (first same as last)
-    d7 = h * (B1 * om1 + B3 * om3 + B4 * om4 + B5 * om5 + B6 * om6)
-    om7 = om0 + h * (B1 * al1 + B3 * al3 + B4 * al4 + B5 * al5 + B6 * al6)
-    w7_work = y0[Y_WIN] + h * (B1 * pw1 + B3 * pw3 + B4 * pw4 + B5 * pw5 + B6 * pw6)
-    a_end = a0 + da * f
-    b_end = b0 + db * f
-    al7, pw7, c7, sn7 = _rates(p, gain, s, th0, c0, s0, d7, om7, a_end, b_end)
+        al1, pw1 = stuck_rocking_rates(p, gain, c0, s0, s, om0, a0 + da * f0, b0 + db * f0)
+        _store_rates(y0, om0, al1, pw1, stages, 0)
+    th1, om1, w1, al7, pw7, c7, sn7, e_th, e_om = stuck_step(
+        p, gain, s, c0, s0, th0, om0, y0[Y_WIN], al1, pw1, a0, da, b0, db, f0, h / dt, h)
     for i in range(N_STATE):
         y1[i] = y0[i]
-        stages[6, i] = 0.0
-    y1[Y_TH] = th0 + d7
-    y1[Y_OM] = om7
-    y1[Y_WIN] = w7_work
-    stages[6, Y_XB] = y0[Y_VB]
-    stages[6, Y_TH] = om7
-    stages[6, Y_XS] = y0[Y_VS]
-    stages[6, Y_OM] = al7
-    stages[6, Y_WIN] = pw7
-    stages[6, Y_DIS] = 0.0
-    stages[6, Y_IMP] = 0.0
-    # accelerations and forces at the end of the step, for the event functions
-    fx, fy, Fx, Fy = stuck_rocking_forces(p, c7, sn7, s, om7, al7, a_end, p[P_G] + b_end)
+    y1[Y_TH] = th1
+    y1[Y_OM] = om1
+    y1[Y_WIN] = w1
+    _store_rates(y0, om1, al7, pw7, stages, 6)
+    f = (tau + h) / dt
+    stuck_forces_into(p, s, c7, sn7, om1, al7, a0 + da * f, b0 + db * f, w7)
+    return stuck_error_norm(th0, om0, th1, om1, e_th, e_om, rtol, atol)
+
+
+@njit(cache=True, inline="always")
+def _store_rates(y0, om, al, pw, stages, st):
+    """Row ``st`` of the stages: the rates of the whole state in mode 3."""
+    for i in range(N_STATE):
+        stages[st, i] = 0.0
+    stages[st, Y_XB] = y0[Y_VB]
+    stages[st, Y_TH] = om
+    stages[st, Y_XS] = y0[Y_VS]
+    stages[st, Y_OM] = al
+    stages[st, Y_WIN] = pw
+
+
+@njit(cache=True, inline="always")
+def stuck_forces_into(p, s, c, sn, om, al, a, ay, w7):
+    """``w7``: the accelerations and interface forces of mode 3 at geometry ``(c, sn)``."""
+    fx, fy, Fx, Fy = stuck_rocking_forces(p, c, sn, s, om, al, a, p[P_G] + ay)
     w7[I_XB_DD] = 0.0
-    w7[I_TH_DD] = al7
+    w7[I_TH_DD] = al
     w7[I_XS_DD] = 0.0
     w7[I_FX] = fx
     w7[I_FY] = fy
     w7[I_SFX] = Fx
     w7[I_SFY] = Fy
-    # the embedded error estimate (the other dynamic states have none: their rates are zero)
-    e_th = h * (E1 * om1 + E3 * om3 + E4 * om4 + E5 * om5 + E6 * om6 + E7 * om7)
-    e_om = h * (E1 * al1 + E3 * al3 + E4 * al4 + E5 * al5 + E6 * al6 + E7 * al7)
-    sc_th = atol + rtol * max(abs(th0), abs(y1[Y_TH]))
-    sc_om = atol + rtol * max(abs(om0), abs(om7))
-    return math.sqrt(((e_th / sc_th) ** 2 + (e_om / sc_om) ** 2) / N_DYN)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def stuck_rocking_span(p, ms, y, k, dt, ax, ay, has_ay, sh, sv, rtol, atol, armed, g0, g1,
+                       peak_th, peak_th_time, store, hist, modes, mode):
+    """Advance mode 3 by whole samples, one step each, until something may happen.
+
+    The rocking counterpart of :func:`~shipblock.solver._closed_form.nonrocking_span`: the
+    kernel's steps, but with the state and the pivot geometry carried from step to step in
+    registers (the geometry at a step's end is the angle-addition result of its last stage, so
+    no sine or cosine is taken per step). A step is accepted here only if the kernel would
+    accept it with nothing to do: its error norm is at most 1 and no watched event function
+    ends below zero or, for the impact, may have dipped below it inside the step (the rotation
+    heading for zero at the start and away from it at the end). Otherwise the span stops at the
+    step's start and the kernel takes that step itself, locating and applying the event.
+
+    Parameters
+    ----------
+    p : tuple
+        Parameters.
+    ms, y : ndarray
+        Mode state (mode 3) and state at sample ``k`` (``y`` is updated in place).
+    k : int
+        Current sample (the span starts on a sample).
+    dt, ax, ay, has_ay, sh, sv, rtol, atol
+        As in :func:`~shipblock.solver._kernel.run`.
+    armed : ndarray of bool
+        Events being watched; disarmed ones are re-armed once clear of zero.
+    g0, g1 : ndarray, shape (N_EVENTS,)
+        The event functions at the start (updated to those at the span's end) and work.
+    peak_th, peak_th_time : float
+        Running peak of |theta| and its time.
+    store, hist, modes, mode
+        History output as in ``run``, and the mode number to write.
+
+    Returns
+    -------
+    k : int
+        The sample where the span stopped.
+    time_in_mode : float
+        Time advanced [s].
+    peak_th, peak_th_time : float
+        The running peak, updated.
+    """
+    n = ax.shape[0]
+    s = float(ms[MS_S])
+    gain = stuck_rocking_gain(p)
+    th = y[Y_TH]
+    om = y[Y_OM]
+    w = y[Y_WIN]
+    phi = p[P_THC] - s * th
+    c = math.cos(phi)
+    sn = math.sin(phi)
+    a0 = sh * ax[k]
+    b0 = sv * ay[k] if has_ay else 0.0
+    al, pw = stuck_rocking_rates(p, gain, c, sn, s, om, a0, b0)
+    time_in_mode = 0.0
+    all_armed = True
+    for e in range(N_EVENTS):
+        all_armed = all_armed and armed[e]
+    forces_known = False
+    fx = fy = Fx = Fy = 0.0
+    while k < n - 1:
+        a1 = sh * ax[k + 1]
+        b1 = sv * ay[k + 1] if has_ay else 0.0
+        th1, om1, w1, al1, pw1, c1, sn1, e_th, e_om = stuck_step(
+            p, gain, s, c, sn, th, om, w, al, pw, a0, a1 - a0, b0, b1 - b0, 0.0, 1.0, dt)
+        # the error norm of stuck_error_norm <= 1, without its divisions and square root
+        sc_th = atol + rtol * max(abs(th), abs(th1))
+        sc_om = atol + rtol * max(abs(om), abs(om1))
+        if not ((e_th * sc_om) ** 2 + (e_om * sc_th) ** 2 <= N_DYN * (sc_th * sc_om) ** 2):
+            break  # a smaller step is needed (or the state is not finite)
+        fx1, fy1, Fx1, Fy1 = stuck_rocking_forces(p, c1, sn1, s, om1, al1, a1, p[P_G] + b1)
+        y[Y_TH] = th1
+        event_functions(p, ms, y, fx1, fy1, Fx1, Fy1, g1)
+        quiet = not (armed[EV_IMPACT] and s * th > 0.0 and s * om < 0.0 and s * om1 > 0.0)
+        for e in range(N_EVENTS):
+            if g1[e] < 0.0 and armed[e]:
+                quiet = False
+        if not quiet:
+            y[Y_TH] = th
+            break
+        if not all_armed:
+            all_armed = True
+            for e in range(N_EVENTS):
+                if not armed[e] and g1[e] > REARM_TOL:
+                    armed[e] = True
+                all_armed = all_armed and armed[e]
+        if om * om1 < 0.0:
+            ext, s_ext = rotation_extremum(th, om, al, th1, om1, al1, dt)
+            if ext > peak_th:
+                peak_th = ext
+                peak_th_time = k * dt + s_ext
+        if abs(th1) > peak_th:
+            peak_th = abs(th1)
+            peak_th_time = k * dt + dt
+        time_in_mode += dt
+        k += 1
+        th, om, w, al, pw, c, sn, a0, b0 = th1, om1, w1, al1, pw1, c1, sn1, a1, b1
+        fx, fy, Fx, Fy = fx1, fy1, Fx1, Fy1
+        forces_known = True
+        y[Y_OM] = om
+        y[Y_WIN] = w
+        if store:
+            for i in range(N_STATE):
+                hist[i, k] = y[i]
+            hist[H_KIN, k] = kinetic_energy(p, th, s, 1, y[Y_VB], om, y[Y_VS])
+            hist[H_POT, k] = potential_energy(p, th)
+            modes[k] = mode
+    if forces_known:
+        # the event functions where the span stopped, for the kernel's next step
+        event_functions(p, ms, y, fx, fy, Fx, Fy, g0)
+    return k, time_in_mode, peak_th, peak_th_time
