@@ -120,8 +120,15 @@ def _turned(sd, cd, pr, qr, pp, qp, om):
 
 
 @njit(cache=True, inline="always")
-def _turn_coefficients(gain, kpow, s, c0, s0, a, ay, G):
-    """``(P, Q)`` of the rate and of the power at input ``(a, ay)``, ``G = g + ay``."""
+def _turn_coefficients(gain, kpow, s, c0, s0, a0, da, b0, db, G0, f):
+    """``(P, Q)`` of the rate and of the power at the fraction ``f`` of the sample interval.
+
+    The input there is ``a = a0 + da f``, ``ay = b0 + db f`` and ``G = G0 + db f``
+    (``G0 = g + b0``).
+    """
+    a = a0 + da * f
+    ay = b0 + db * f
+    G = G0 + db * f
     sa = s * a
     return (gain * (a * c0 - s * G * s0), gain * (sa * s0 + G * c0),
             kpow * (a * c0 - s * ay * s0), kpow * (sa * s0 + ay * c0))
@@ -174,22 +181,11 @@ def stuck_step(p, gain, s, c0, s0, th0, om0, w0, al1, pw1, a0, da, b0, db, f0, f
     G0 = p[P_G] + b0
     kpow = (p[P_NM] + 2.0 * p[P_M]) * p[P_R]
     # the input at each stage, and its (P, Q) coefficients: off the chain of stages
-    f = f0 + C2 * fh
-    pr2, qr2, pp2, qp2 = _turn_coefficients(gain, kpow, s, c0, s0, a0 + da * f, b0 + db * f,
-                                            G0 + db * f)
-    f = f0 + C3 * fh
-    pr3, qr3, pp3, qp3 = _turn_coefficients(gain, kpow, s, c0, s0, a0 + da * f, b0 + db * f,
-                                            G0 + db * f)
-    f = f0 + C4 * fh
-    pr4, qr4, pp4, qp4 = _turn_coefficients(gain, kpow, s, c0, s0, a0 + da * f, b0 + db * f,
-                                            G0 + db * f)
-    f = f0 + C5 * fh
-    pr5, qr5, pp5, qp5 = _turn_coefficients(gain, kpow, s, c0, s0, a0 + da * f, b0 + db * f,
-                                            G0 + db * f)
-    f = f0 + fh
-    a_end = a0 + da * f
-    b_end = b0 + db * f
-    pr6, qr6, pp6, qp6 = _turn_coefficients(gain, kpow, s, c0, s0, a_end, b_end, G0 + db * f)
+    pr2, qr2, pp2, qp2 = _turn_coefficients(gain, kpow, s, c0, s0, a0, da, b0, db, G0, f0 + C2 * fh)
+    pr3, qr3, pp3, qp3 = _turn_coefficients(gain, kpow, s, c0, s0, a0, da, b0, db, G0, f0 + C3 * fh)
+    pr4, qr4, pp4, qp4 = _turn_coefficients(gain, kpow, s, c0, s0, a0, da, b0, db, G0, f0 + C4 * fh)
+    pr5, qr5, pp5, qp5 = _turn_coefficients(gain, kpow, s, c0, s0, a0, da, b0, db, G0, f0 + C5 * fh)
+    pr6, qr6, pp6, qp6 = _turn_coefficients(gain, kpow, s, c0, s0, a0, da, b0, db, G0, f0 + fh)
     # each stage's sums end with a fused term: the newest rate, the only one just computed
     om1 = om0
     om2 = fma(h * A21, al1, om0)
