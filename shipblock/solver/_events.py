@@ -26,11 +26,27 @@ from shipblock.solver._layout import (
     MS_SLIP1,
     MS_SLIP2,
     N_EVENTS,
+    REARM_TOL,
     Y_TH,
     Y_VB,
     Y_VS,
 )
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R, P_THC
+
+
+@njit(cache=True, inline="always")
+def rearm(armed, g):
+    """Re-arm the disarmed events whose function ``g`` is clear of zero: True if all are armed.
+
+    An event disarmed after a grazing contact is watched again once its function exceeds
+    ``REARM_TOL``.
+    """
+    all_armed = True
+    for e in range(N_EVENTS):
+        if not armed[e] and g[e] > REARM_TOL:
+            armed[e] = True
+        all_armed = all_armed and armed[e]
+    return all_armed
 
 
 @njit(cache=True, inline="always")

@@ -156,3 +156,21 @@ def rotation_extremum(th0, om0, al0, th1, om1, al1, h):
     if u < 0.0:
         return max(abs(th0), abs(th1)), 0.0
     return abs(poly5(c0, c1, c2, c3, c4, c5, u)), u * h
+
+
+@njit(cache=True, inline="always")
+def rotation_peak(peak, peak_time, th0, om0, al0, th1, om1, al1, h, t0, t1):
+    """The running peak of |theta| and its time, updated with an accepted rocking step.
+
+    The step runs from ``t0`` to ``t1 = t0 + h`` (both given, so that callers keep their own
+    arithmetic for times); an extremum inside it is read off :func:`rotation_extremum`.
+    """
+    if om0 * om1 < 0.0:
+        ext, s_ext = rotation_extremum(th0, om0, al0, th1, om1, al1, h)
+        if ext > peak:
+            peak = ext
+            peak_time = t0 + s_ext
+    if abs(th1) > peak:
+        peak = abs(th1)
+        peak_time = t1
+    return peak, peak_time

@@ -40,13 +40,14 @@ from shipblock.impact import apply_impact
 from shipblock.modes import MODE_NUMBER, EventKind, Failure
 from shipblock.solver._closed_form import nonrocking_span
 from shipblock.solver._dopri import DP_A, DP_C, DP_E, DP_ERROR_ORDER
-from shipblock.solver._events import event_functions, rotation_event
+from shipblock.solver._events import event_functions, rearm, rotation_event
 from shipblock.solver._ground import ground_motion_at
+from shipblock.solver._history import store_sample
 from shipblock.solver._interpolate import (
     bracketed_root,
     hermite_extremum,
     quintic_hermite,
-    rotation_extremum,
+    rotation_peak,
 )
 from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrappers)
     ACC_TOL,
@@ -114,7 +115,7 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     Y_XS,
     parameter_tuple,
 )
-from shipblock.solver._stuck_rocking import advance_stuck, stuck_rocking_span
+from shipblock.solver._stuck_rocking import advance_stuck, is_stuck_rocking, stuck_rocking_span
 from shipblock.solver._workqueue import claim_next
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
@@ -162,8 +163,7 @@ def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, 
         for i in range(y0.shape[0]):
             y1[i] = y0[i]
         return 0.0
-    if (ms[MS_ROCK] and not ms[MS_SLIP1] and not ms[MS_SLIP2] and y0[Y_VB] == 0.0
-            and y0[Y_VS] == 0.0):
+    if is_stuck_rocking(ms, y0):
         return advance_stuck(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, w7,
                              first_stage_known, rtol, atol)
     if not advance_general(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp,
@@ -650,7 +650,7 @@ summary, y_init
         uplift = 1
     event_values(p, ms, y, 0, 0.0, dt, ax, ay, has_ay, sh, sv, g0, w7)
     if store:
-        store_sample(p, ms, y, hist, modes, 0, failure != 0)
+        store_sample(p, ms, y, hist, modes, 0, 0 if failure else mode_number(ms))
     h_rock = dt
     events_here = 0
     while k < n - 1 and failure == 0:
@@ -671,8 +671,7 @@ summary, y_init
                 failure_time = k * dt + tau
                 break
         else:
-            if (tau == 0.0 and h_rock >= dt and ms[MS_SLIP1] == 0 and ms[MS_SLIP2] == 0
-                    and y[Y_VB] == 0.0 and y[Y_VS] == 0.0):
+            if tau == 0.0 and h_rock >= dt and is_stuck_rocking(ms, y):
                 # the usual rocking mode from a sample on: whole samples while nothing happens
                 k_before = k
                 k, span_time, peak_th, peak_th_time = stuck_rocking_span(
@@ -772,20 +771,16 @@ summary, y_init
                         best_e = e
             if best_e < 0:
                 # accept the whole step
-                if y[Y_OM] * y1[Y_OM] < 0.0:
-                    ext, s_ext = rotation_extremum(y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM],
-                                                   al1, h)
-                    if ext > peak_th:
-                        peak_th = ext
-                        peak_th_time = k * dt + tau + s_ext
+                peak_th, peak_th_time = rotation_peak(
+                    peak_th, peak_th_time, y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h,
+                    k * dt + tau, k * dt + (tau + h))
                 for i in range(N_STATE):
                     y[i] = y1[i]
                     stages[0, i] = f_end[i]  # first same as last: f(y) for the next step
                 fsal = True
                 for e in range(N_EVENTS):
                     g0[e] = g1[e]
-                    if not armed[e] and g1[e] > REARM_TOL:
-                        armed[e] = True
+                rearm(armed, g1)
                 summary[S_MODE_TIME + mode_number(ms) - 1] += h
                 tau += h
                 if h < remaining:
@@ -889,7 +884,7 @@ summary, y_init
             tau = 0.0
             events_here = 0
             if store:
-                store_sample(p, ms, y, hist, modes, k, False)
+                store_sample(p, ms, y, hist, modes, k, mode_number(ms))
     end_time = k * dt + tau
     if failure != 0 and store:
         for j in range(k + 1, n):
@@ -916,17 +911,6 @@ summary, y_init
     summary[S_ENERGY_FINAL] = kinetic_energy(
         p, y[Y_TH], s_final, ms[MS_ROCK], y[Y_VB], y[Y_OM], y[Y_VS]
     ) + potential_energy(p, y[Y_TH])
-
-
-@njit(cache=True, _nrt=False)
-def store_sample(p, ms, y, hist, modes, k, failed):
-    """Write the state, kinetic and potential energy and mode of sample ``k``."""
-    for i in range(N_STATE):
-        hist[i, k] = y[i]
-    s = float(ms[MS_S]) if ms[MS_ROCK] else 1.0
-    hist[H_KIN, k] = kinetic_energy(p, y[Y_TH], s, ms[MS_ROCK], y[Y_VB], y[Y_OM], y[Y_VS])
-    hist[H_POT, k] = potential_energy(p, y[Y_TH])
-    modes[k] = 0 if failed else mode_number(ms)
 
 
 @njit(cache=True, parallel=True)

@@ -33,25 +33,24 @@ from shipblock.equations import (
     I_TH_DD,
     I_XB_DD,
     I_XS_DD,
-    kinetic_energy,
-    potential_energy,
     stuck_rocking_forces,
     stuck_rocking_gain,
     stuck_rocking_rates,
 )
 from shipblock.solver._dopri import DP_A, DP_C, DP_E
-from shipblock.solver._events import event_functions
+from shipblock.solver._events import event_functions, rearm
 from shipblock.solver._fused import fma
-from shipblock.solver._interpolate import rotation_extremum
+from shipblock.solver._history import store_sample
+from shipblock.solver._interpolate import rotation_peak
 from shipblock.solver._layout import (
     EV_IMPACT,
-    H_KIN,
-    H_POT,
+    MS_ROCK,
     MS_S,
+    MS_SLIP1,
+    MS_SLIP2,
     N_DYN,
     N_EVENTS,
     N_STATE,
-    REARM_TOL,
     Y_OM,
     Y_TH,
     Y_VB,
@@ -225,6 +224,13 @@ def stuck_error_norm(th0, om0, th1, om1, e_th, e_om, rtol, atol):
 
 
 @njit(cache=True, inline="always")
+def is_stuck_rocking(ms, y):
+    """Whether mode ``ms`` at state ``y`` is mode 3: rocking, no interface slipping."""
+    return (ms[MS_ROCK] != 0 and ms[MS_SLIP1] == 0 and ms[MS_SLIP2] == 0 and y[Y_VB] == 0.0
+            and y[Y_VS] == 0.0)
+
+
+@njit(cache=True, inline="always")
 def advance_stuck(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, w7,
                   first_stage_known, rtol, atol):
     """One Dormand-Prince 5(4) step of ``h`` in mode 3: the error norm (>= 0).
@@ -346,9 +352,7 @@ def stuck_rocking_span(p, ms, y, k, dt, ax, ay, has_ay, sh, sv, rtol, atol, arme
     b0 = sv * ay[k] if has_ay else 0.0
     al, pw = stuck_rocking_rates(p, gain, c, sn, s, om, a0, b0)
     time_in_mode = 0.0
-    all_armed = True
-    for e in range(N_EVENTS):
-        all_armed = all_armed and armed[e]
+    all_armed = False  # until rearm() has looked
     forces_known = False
     fx = fy = Fx = Fy = 0.0
     while k < n - 1:
@@ -372,19 +376,9 @@ def stuck_rocking_span(p, ms, y, k, dt, ax, ay, has_ay, sh, sv, rtol, atol, arme
             y[Y_TH] = th
             break
         if not all_armed:
-            all_armed = True
-            for e in range(N_EVENTS):
-                if not armed[e] and g1[e] > REARM_TOL:
-                    armed[e] = True
-                all_armed = all_armed and armed[e]
-        if om * om1 < 0.0:
-            ext, s_ext = rotation_extremum(th, om, al, th1, om1, al1, dt)
-            if ext > peak_th:
-                peak_th = ext
-                peak_th_time = k * dt + s_ext
-        if abs(th1) > peak_th:
-            peak_th = abs(th1)
-            peak_th_time = k * dt + dt
+            all_armed = rearm(armed, g1)
+        peak_th, peak_th_time = rotation_peak(peak_th, peak_th_time, th, om, al, th1, om1, al1,
+                                              dt, k * dt, k * dt + dt)
         time_in_mode += dt
         k += 1
         th, om, w, al, pw, c, sn, a0, b0 = th1, om1, w1, al1, pw1, c1, sn1, a1, b1
@@ -393,11 +387,7 @@ def stuck_rocking_span(p, ms, y, k, dt, ax, ay, has_ay, sh, sv, rtol, atol, arme
         y[Y_OM] = om
         y[Y_WIN] = w
         if store:
-            for i in range(N_STATE):
-                hist[i, k] = y[i]
-            hist[H_KIN, k] = kinetic_energy(p, th, s, 1, y[Y_VB], om, y[Y_VS])
-            hist[H_POT, k] = potential_energy(p, th)
-            modes[k] = mode
+            store_sample(p, ms, y, hist, modes, k, mode)
     if forces_known:
         # the event functions where the span stopped, for the kernel's next step
         event_functions(p, ms, y, fx, fy, Fx, Fy, g0)

@@ -1,0 +1,23 @@
+"""History columns of the solver: the state, its energies and the mode at a sample (compiled)."""
+
+from __future__ import annotations
+
+from numba import njit
+
+from shipblock.equations import kinetic_energy, potential_energy
+from shipblock.solver._layout import H_KIN, H_POT, MS_ROCK, MS_S, N_STATE, Y_OM, Y_TH, Y_VB, Y_VS
+
+
+@njit(cache=True, _nrt=False)
+def store_sample(p, ms, y, hist, modes, k, mode):
+    """Write the state, kinetic and potential energy and mode number ``mode`` of sample ``k``.
+
+    ``mode`` is 0 after a failure. (Rest and sliding phases, with theta = 0, write theirs in
+    :mod:`~shipblock.solver._closed_form`.)
+    """
+    for i in range(N_STATE):
+        hist[i, k] = y[i]
+    s = float(ms[MS_S]) if ms[MS_ROCK] else 1.0
+    hist[H_KIN, k] = kinetic_energy(p, y[Y_TH], s, ms[MS_ROCK], y[Y_VB], y[Y_OM], y[Y_VS])
+    hist[H_POT, k] = potential_energy(p, y[Y_TH])
+    modes[k] = mode
