@@ -12,8 +12,9 @@ from shipblock import ShipBlockSystem, simulate, simulate_batch
 from shipblock.equations import solve_mode
 from shipblock.solver._closed_form import (
     add_repeated,
+    held_fails_at,
+    held_interval,
     rest_breaks,
-    rest_interval,
     skip_rest,
     slip_may_stop,
 )
@@ -94,7 +95,7 @@ def test_rest_blocks_skip_exactly_the_passing_samples(has_ay, fast):
     assert breaks.sum() > 10
     for j in range(n):
         assert rest_breaks(ax[j], ay[j], has_ay, sh, sv, *c) == breaks[j]
-    lo, hi = rest_interval(*c) if fast and not has_ay else (1.0, -1.0)
+    lo, hi = held_interval(0, 0, *c) if fast and not has_ay else (1.0, -1.0)
     for k0 in list(rng.choice(n - 1, 60, replace=False)) + [0, n - 40, n - 2]:
         k, time = skip_rest(ax, ay, has_ay, sh, sv, int(k0), dt, 0.25, *c, lo, hi)
         assert k0 <= k <= n - 1
@@ -108,7 +109,7 @@ def test_rest_blocks_skip_exactly_the_passing_samples(has_ay, fast):
 
 def test_rest_interval_passes_the_screen_near_its_ends():
     c = rest_coefficients(ShipBlockSystem.example())
-    lo, hi = rest_interval(*c)
+    lo, hi = held_interval(0, 0, *c)
     assert lo < 0.0 < hi
     a = np.concatenate([np.linspace(lo, hi, 2001), lo + (hi - lo) * 1e-12 * np.arange(50),
                         hi - (hi - lo) * 1e-12 * np.arange(50)])
@@ -116,6 +117,72 @@ def test_rest_interval_passes_the_screen_near_its_ends():
     # and it is not much narrower than the screen: slightly beyond either end rest breaks
     assert rest_breaks(lo * (1 + 1e-6), 0.0, False, 1.0, 0.0, *c)
     assert rest_breaks(hi * (1 + 1e-6), 0.0, False, 1.0, 0.0, *c)
+
+
+def slot_coefficients(system, slip1, sig1, slip2, sig2):
+    """Response vectors of a non-rocking mode as the span takes them (None if singular)."""
+    p = parameter_tuple(system.to_parameter_vector())
+    wa, wg = np.empty(7), np.empty(7)
+    if not (solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
+            and solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)):
+        return None
+    return (p[P_G], wa[3], wg[3], wa[4], wg[4], wa[5], wg[5], wa[6], wg[6], p[P_MUS1], p[P_MUS2],
+            p[P_B], p[P_H])
+
+
+def span_held_screen(slip1, slip2, a1, G1, c):
+    """The held conditions of the span's screen written out (Python): normal forces, the
+    moment criterion, the friction cone of each sticking interface."""
+    _, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H = c
+    fx1, fy1 = fx_a * a1 + fx_g * G1, fy_a * a1 + fy_g * G1
+    Fx1, Fy1 = Fx_a * a1 + Fx_g * G1, Fy_a * a1 + Fy_g * G1
+    return (fy1 <= 0.0 or Fy1 <= 0.0 or B * (fy1 + Fy1) < H * abs(fx1 + Fx1)
+            or (not slip1 and mus1 * fy1 < abs(fx1)) or (not slip2 and mus2 * Fy1 < abs(Fx1)))
+
+
+@pytest.mark.parametrize("system", [
+    ShipBlockSystem.example(),
+    ShipBlockSystem.example().replace(mu_s_ground=0.1, mu_k_ground=0.08, mu_s_ship=0.3,
+                                      mu_k_ship=0.25, half_height=2.0),
+])
+def test_held_interval_of_every_non_rocking_mode_passes_the_screen(system):
+    """Inside the interval of a non-rocking mode the held conditions pass as the span computes
+    them, up to the ends (the span then skips computing them); just beyond an end they fail,
+    so the interval is not needlessly narrow."""
+    rng = np.random.default_rng(4)
+    n_known = 0
+    for slip1, sig1 in ((0, 1.0), (1, 1.0), (1, -1.0)):
+        for slip2, sig2 in ((0, 1.0), (1, 1.0), (1, -1.0)):
+            c = slot_coefficients(system, slip1, sig1, slip2, sig2)
+            if c is None:
+                continue
+            grav = c[0]
+            lo, hi = held_interval(slip1, slip2, *c)
+            # the compiled screen is the screen written out, on random inputs with and
+            # without a vertical component
+            for a1, b1 in zip(rng.normal(size=300) * 8.0, rng.normal(size=300) * 3.0, strict=True):
+                for G1 in (grav + 0.0, grav + b1):
+                    assert held_fails_at(slip1, slip2, a1, G1, *c[1:]) == span_held_screen(
+                        slip1, slip2, a1, G1, c)
+            if lo > hi:
+                continue  # no interval known: every sample is screened in full
+            n_known += 1
+            if not np.isfinite(hi - lo):
+                # a does not enter the held conditions (they are then constant and hold): the
+                # blocks slip, so the forces are friction forces and what moves the ship with them
+                assert slip1 and c[1] == 0.0 and c[5] == 0.0
+                assert not any(span_held_screen(slip1, slip2, x, grav + 0.0, c)
+                               for x in rng.normal(size=200) * 1e3)
+                continue
+            a = np.concatenate([np.linspace(lo, hi, 2001), lo + (hi - lo) * 1e-12 * np.arange(50),
+                                hi - (hi - lo) * 1e-12 * np.arange(50)])
+            assert not any(span_held_screen(slip1, slip2, x, grav + 0.0, c) for x in a)
+            width = hi - lo
+            if not (slip1 and slip2) and not (slip1 and hi - lo > 1e3 * grav):
+                # bounded by a friction cone or the moment criterion, not by the cap
+                assert span_held_screen(slip1, slip2, lo - 1e-6 * width, grav + 0.0, c)
+                assert span_held_screen(slip1, slip2, hi + 1e-6 * width, grav + 0.0, c)
+    assert n_known >= 7  # rest, the one-interface slides and the two-layer slides
 
 
 def test_repeated_addition_equals_the_loop():

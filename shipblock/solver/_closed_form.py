@@ -14,10 +14,13 @@ samples a and G are linear in time, so within a sample interval
 
 :func:`nonrocking_span` runs this loop over as many samples as the mode lasts without leaving
 compiled code or touching the general event machinery, which is what makes sliding and rest
-phases cheap. At rest nothing moves and whether an interval may hold an event depends on the
-input at its end alone, so long rest phases are screened a block of samples at a time
-(:func:`skip_rest`; without a vertical input, mostly by two comparisons a sample against the
-interval of accelerations at which rest surely holds). The span stops at the first event, with
+phases cheap. Without a vertical input the conditions a non-rocking mode holds (positive
+normal forces, no uplift, stick forces inside their friction cones) hold surely for horizontal
+accelerations in an interval (:func:`held_interval`), so a sample inside it is screened only
+for a slip that may stop, without the normal forces being computed. At rest nothing moves
+and whether an interval may hold an event depends on the input at its end alone, so long
+rest phases are screened a block of samples at a time (:func:`skip_rest`; without a vertical
+input, mostly by two comparisons a sample against the interval of rest). The span stops at the first event, with
 the state advanced exactly to it (the same polynomials, cut at the root), and returns the event
 for the general kernel to apply.
 
@@ -69,14 +72,12 @@ from shipblock.solver._layout import (
     REARM_TOL,
     ROOT_TIME_TOL,
     W_G,
+    W_HELD,
     W_INV_W,
     W_INV_WR,
     W_INV_WS,
     W_RESP,
     W_RESP_STATE,
-    W_REST_HI,
-    W_REST_LO,
-    W_REST_SET,
     Y_DIS,
     Y_VB,
     Y_VS,
@@ -91,7 +92,7 @@ NO_ROOT = math.inf
 REST_BLOCK = 32
 #: Samples of a rest phase screened one by one before :func:`skip_rest` takes over.
 REST_FIRST = 32
-#: Samples checked at once against the interval of :func:`rest_interval`: a loop of 32 so
+#: Samples checked at once against the interval of :func:`held_interval`: a loop of 32 so
 #: short would be unrolled whole and not vectorised.
 FAST_BLOCK = 64
 
@@ -234,33 +235,52 @@ def exact_update_one(y, ix, iv, h, u0, u1, a0, a1, f0, f1, m):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def rest_breaks(ax_j, ay_j, has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g,
-                mus1, mus2, B, H):
-    """Whether rest (mode 1, every event armed) fails the screen of :func:`nonrocking_span` at
-    the end of an interval whose end sample is ``ax_j``, ``ay_j``: the same expressions,
-    without branches.
+def held_fails_at(slip1, slip2, a1, G1, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1,
+                  mus2, B, H):
+    """Whether the conditions a non-rocking mode holds fail, at scaled ground input ``a1``,
+    ``G1 = g + b1``, as the screen of :func:`nonrocking_span` computes them (no branches).
 
-    At rest nothing moves, so the screen depends on the input at the end sample alone.
+    The held conditions: both normal forces positive, the blocks' moment criterion (no
+    uplift), and the static friction cone of each interface that sticks (``slip1``,
+    ``slip2`` zero). A slipping interface's own condition, that its slip may stop, depends on
+    the state and is screened apart.
     """
-    a1 = sh * ax_j
-    G1 = grav + (sv * ay_j if has_ay else 0.0)
     fx1 = fx_a * a1 + fx_g * G1
     fy1 = fy_a * a1 + fy_g * G1
     Fx1 = Fx_a * a1 + Fx_g * G1
     Fy1 = Fy_a * a1 + Fy_g * G1
     return ((fy1 <= 0.0) | (Fy1 <= 0.0) | (B * (fy1 + Fy1) < H * abs(fx1 + Fx1))
-            | (mus1 * fy1 < abs(fx1)) | (mus2 * Fy1 < abs(Fx1)))
+            | ((slip1 == 0) & (mus1 * fy1 < abs(fx1))) | ((slip2 == 0) & (mus2 * Fy1 < abs(Fx1))))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def rest_breaks(ax_j, ay_j, has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g,
+                mus1, mus2, B, H):
+    """Whether rest (mode 1, every event armed) fails the screen of :func:`nonrocking_span` at
+    the end of an interval whose end sample is ``ax_j``, ``ay_j``.
+
+    At rest nothing moves, so the screen is :func:`held_fails_at` of the input at the end
+    sample alone.
+    """
+    return held_fails_at(0, 0, sh * ax_j, grav + (sv * ay_j if has_ay else 0.0), fx_a, fx_g,
+                         fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
 
 
 @njit(cache=True, error_model="numpy")
-def rest_interval(grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H):
-    """Horizontal accelerations ``[lo, hi]`` at which rest surely passes the screen of
-    :func:`rest_breaks` when there is no vertical input (``lo > hi`` if none is known).
+def held_interval(slip1, slip2, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2,
+                  B, H):
+    """Horizontal accelerations ``[lo, hi]`` at which the held conditions of a non-rocking mode
+    surely pass :func:`held_fails_at` when there is no vertical input (``lo > hi`` if none is
+    known).
 
-    With ``G = g`` and the normal forces independent of ``a`` (as they are at rest), every
-    condition of the screen reads ``|s a + q| <= r``: an interval of ``a``. Their intersection
-    is shrunk by a margin (1e-9 relative) far above the round-off of the screen's arithmetic,
-    so a sample inside passes the screen as computed; a sample outside is screened as before.
+    With ``G = g`` and the normal forces independent of ``a`` (as they are while the blocks
+    do not rock), every held condition reads ``|s a + q| <= r``: an interval of ``a`` (all of
+    them if ``s = 0``, as for the moment criterion while both interfaces slip). Their
+    intersection is shrunk by a margin (1e-9 relative) and kept where the terms in ``a`` are
+    at most 1e4 times ``|q| + r``, so that the round-off of the screen's arithmetic (some
+    1e-16 of its terms) stays far below the margin: a sample inside passes the screen as
+    computed; a sample outside is screened in full. Finite ends are checked against the
+    screen itself; an infinite one means that ``a`` does not enter the conditions at all.
     """
     empty = (1.0, -1.0)
     if fy_a != 0.0 or Fy_a != 0.0 or not H > 0.0:
@@ -274,11 +294,20 @@ def rest_interval(grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mu
     for i in range(3):
         if i == 0:  # the moment criterion
             s, q, r = fx_a + Fx_a, (fx_g + Fx_g) * grav, B * (fy + Fy) / H
-        elif i == 1:  # the ground friction cone
-            s, q, r = fx_a, fx_g * grav, mus1 * fy
+            scale = abs(fx_a) + abs(Fx_a)
+        elif i == 1:  # the ground friction cone, if the ground interface sticks
+            if slip1:
+                continue
+            s, q, r, scale = fx_a, fx_g * grav, mus1 * fy, abs(fx_a)
         else:  # the ship's
-            s, q, r = Fx_a, Fx_g * grav, mus2 * Fy
+            if slip2:
+                continue
+            s, q, r, scale = Fx_a, Fx_g * grav, mus2 * Fy, abs(Fx_a)
         margin = 1e-9 * (abs(q) + abs(r))
+        if scale > 0.0:
+            cap = 1e4 * (abs(q) + abs(r)) / scale
+            lo = max(lo, -cap)
+            hi = min(hi, cap)
         if s == 0.0:
             if not abs(q) < r - margin:
                 return empty
@@ -287,14 +316,13 @@ def rest_interval(grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mu
         w = (r - margin) / abs(s)
         lo = max(lo, c - w)
         hi = min(hi, c + w)
-    if not (lo <= hi and math.isfinite(lo) and math.isfinite(hi)):
+    if not lo <= hi or math.isnan(lo) or math.isnan(hi):
         return empty
-    # the ends themselves pass the screen (a check of the margin's argument)
-    if rest_breaks(lo, 0.0, False, 1.0, 0.0, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a,
-                   Fy_g, mus1, mus2, B, H) or rest_breaks(
-            hi, 0.0, False, 1.0, 0.0, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g,
-            mus1, mus2, B, H):
-        return empty
+    # the finite ends themselves pass the screen (a check of the margin's argument)
+    for end in (lo, hi):
+        if math.isfinite(end) and held_fails_at(slip1, slip2, end, grav + 0.0, fx_a, fx_g, fy_a,
+                                                fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H):
+            return empty
     return lo, hi
 
 
@@ -359,7 +387,7 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
         As :func:`rest_breaks` takes them.
     lo, hi : float
         Scaled horizontal accelerations at which rest surely passes the screen
-        (:func:`rest_interval`; ``lo > hi`` for none, as with a vertical input).
+        (:func:`held_interval` of rest; ``lo > hi`` for none, as with a vertical input).
 
     Returns
     -------
@@ -444,8 +472,8 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         modes its state (0 not solved yet, 1 solved, 2 singular) and response vectors ``w_a``,
         ``w_G``, solved on a mode's first span and reused by its later spans in the run (a
         stick-slip record enters the same few modes thousands of times); the inverse weights
-        that scale the event functions, set by the first span; the interval of
-        :func:`rest_interval`, set by the first long rest phase.
+        that scale the event functions, set by the first span; per response slot the
+        interval of :func:`held_interval`, set with its response vectors.
 
     Returns
     -------
@@ -467,16 +495,22 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
     wa = work[start:start + N_SOLVE_OUT]
     wg = work[start + N_SOLVE_OUT:start + 2 * N_SOLVE_OUT]
     g = work[W_G:W_G + N_EVENTS]
+    grav = p[P_G]
+    mus1, mus2, B, H = p[P_MUS1], p[P_MUS2], p[P_B], p[P_H]
     if work[W_RESP_STATE + slot] == 0.0:
         ok_a = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
         ok_g = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)
         work[W_RESP_STATE + slot] = 1.0 if ok_a and ok_g else 2.0
+        if ok_a and ok_g:
+            work[W_HELD + 2 * slot], work[W_HELD + 2 * slot + 1] = held_interval(
+                slip1, slip2, grav, wa[I_FX], wg[I_FX], wa[I_FY], wg[I_FY], wa[I_SFX], wg[I_SFX],
+                wa[I_SFY], wg[I_SFY], mus1, mus2, B, H)
     if work[W_RESP_STATE + slot] == 2.0:
         return k, tau, -2, 0.0, peak_xb, peak_xs
     ub_a, us_a, fx_a, fy_a, Fx_a, Fy_a = wa[I_XB_DD], wa[I_XS_DD], wa[I_FX], wa[I_FY], wa[I_SFX], wa[I_SFY]
     ub_g, us_g, fx_g, fy_g, Fx_g, Fy_g = wg[I_XB_DD], wg[I_XS_DD], wg[I_FX], wg[I_FY], wg[I_SFX], wg[I_SFY]
-    grav = p[P_G]
-    mus1, mus2, B, H = p[P_MUS1], p[P_MUS2], p[P_B], p[P_H]
+    # without a vertical input, the held conditions surely hold for a in [lo, hi]
+    lo, hi = (work[W_HELD + 2 * slot], work[W_HELD + 2 * slot + 1]) if not has_ay else (1.0, -1.0)
     M = p[P_M]
     mass_b = p[P_NM] + M
     if work[W_INV_W] == 0.0:
@@ -496,19 +530,14 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         # The first intervals are screened one by one (rest often ends within a few), then
         # skip_rest goes on up to the first that fails, where the loop below takes over.
         k_first = k
-        while k < n - 1 and k - k_first < REST_FIRST and not rest_breaks(
-                ax[k + 1], ay[k + 1], has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g,
-                Fy_a, Fy_g, mus1, mus2, B, H):
+        while k < n - 1 and k - k_first < REST_FIRST and (
+                lo <= sh * ax[k + 1] <= hi or not rest_breaks(
+                    ax[k + 1], ay[k + 1], has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a,
+                    Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)):
             time_in_mode += dt - tau
             tau = 0.0
             k += 1
         if k - k_first == REST_FIRST:
-            if work[W_REST_SET] == 0.0:
-                # once per run (the rest response is the same in every rest span)
-                work[W_REST_LO], work[W_REST_HI] = rest_interval(
-                    grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
-                work[W_REST_SET] = 1.0
-            lo, hi = (work[W_REST_LO], work[W_REST_HI]) if not has_ay else (1.0, -1.0)
             k, time_in_mode = skip_rest(ax, ay, has_ay, sh, sv, k, dt, time_in_mode, grav, fx_a,
                                         fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B,
                                         H, lo, hi)
@@ -517,34 +546,45 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
     a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # start of the interval
     G0 = grav + b0
     fx0 = fx_a * a0 + fx_g * G0
-    fy0 = fy_a * a0 + fy_g * G0
     Fx0 = Fx_a * a0 + Fx_g * G0
-    Fy0 = Fy_a * a0 + Fy_g * G0
     ub0 = ub_a * a0 + ub_g * G0
     us0 = us_a * a0 + us_g * G0
+    fx_gg, Fx_gg, ub_gg, us_gg = fx_g * grav, Fx_g * grav, ub_g * grav, us_g * grav
     while k < n - 1:
         h = dt - tau
         a1 = sh * ax[k + 1]
         b1 = sv * ay[k + 1] if has_ay else 0.0
         G1 = grav + b1
-        fx1 = fx_a * a1 + fx_g * G1
-        fy1 = fy_a * a1 + fy_g * G1
-        Fx1 = Fx_a * a1 + Fx_g * G1
-        Fy1 = Fy_a * a1 + Fy_g * G1
-        ub1 = ub_a * a1 + ub_g * G1
-        us1 = us_a * a1 + us_g * G1
+        if has_ay:
+            fx1 = fx_a * a1 + fx_g * G1
+            Fx1 = Fx_a * a1 + Fx_g * G1
+            ub1 = ub_a * a1 + ub_g * G1
+            us1 = us_a * a1 + us_g * G1
+        else:
+            # G1 = g exactly: the same values with the products in g taken once
+            fx1 = fx_a * a1 + fx_gg
+            Fx1 = Fx_a * a1 + Fx_gg
+            ub1 = ub_a * a1 + ub_gg
+            us1 = us_a * a1 + us_gg
         vb0 = y[Y_VB]
         vs0 = y[Y_VS]
         # Cheap screen at the end of the interval: force-type event functions are linear (or
         # concave) in time and can only fire if negative at the end; slip velocities are
         # quadratic and can also dip below zero inside. Only a suspect interval is searched.
-        suspect = not all_armed or fy1 <= 0.0 or Fy1 <= 0.0 \
-            or B * (fy1 + Fy1) < H * abs(fx1 + Fx1)
-        # each interface: a slip that may stop, or a stick force leaving its friction cone
-        ground = slip_may_stop(sig1, vb0, ub0, ub1, h) if slip1 else mus1 * fy1 < abs(fx1)
-        ship = slip_may_stop(sig2, vs0, us0, us1, h) if slip2 else mus2 * Fy1 < abs(Fx1)
-        suspect = suspect or ground or ship
+        # The held conditions (normal forces, moment criterion, stick cones) need no check
+        # inside [lo, hi]; the normal forces are then not computed at all.
+        suspect = not all_armed or not lo <= a1 <= hi and held_fails_at(
+            slip1, slip2, a1, G1, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
+        # a slipping interface: its slip may stop
+        if slip1:
+            suspect = suspect or slip_may_stop(sig1, vb0, ub0, ub1, h)
+        if slip2:
+            suspect = suspect or slip_may_stop(sig2, vs0, us0, us1, h)
         if suspect:
+            fy0 = fy_a * a0 + fy_g * G0
+            Fy0 = Fy_a * a0 + Fy_g * G0
+            fy1 = fy_a * a1 + fy_g * G1
+            Fy1 = Fy_a * a1 + Fy_g * G1
             best_h = h + 1.0
             best_e = -1
             for ie in range(N_EVENTS):
@@ -608,9 +648,10 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         tau = 0.0
         # the end of this interval is the start of the next: the same values, not recomputed
         a0 = a1
-        fx0, fy0, Fx0, Fy0, ub0, us0 = fx1, fy1, Fx1, Fy1, ub1, us1
+        G0 = G1
+        fx0, Fx0, ub0, us0 = fx1, Fx1, ub1, us1
         if not all_armed:
-            event_functions(p, ms, y, fx1, fy1, Fx1, Fy1, g)
+            event_functions(p, ms, y, fx1, fy_a * a1 + fy_g * G1, Fx1, Fy_a * a1 + Fy_g * G1, g)
             all_armed = True
             for e in range(N_EVENTS):
                 if not armed[e]:

@@ -62,7 +62,8 @@ N_SUMMARY = 25
 
 # Work array of the closed-form spans (one per run, see ``nonrocking_span``): the event
 # functions, then per response slot its state (0 not solved, 1 solved, 2 singular) and its two
-# response vectors, then the inverse weights (0 until the first span sets them). One array
+# response vectors, then the inverse weights (0 until the first span sets them), then per
+# response slot its interval of held conditions. One array
 # rather than several: the span is called at every event, and numba passes each array argument
 # as several machine words.
 N_RESP_SLOTS = 9  # 3 ground x 3 ship interface states
@@ -72,12 +73,10 @@ W_RESP = W_RESP_STATE + N_RESP_SLOTS
 W_INV_W = W_RESP + 2 * N_SOLVE_OUT * N_RESP_SLOTS  # 1 / weight
 W_INV_WS = W_INV_W + 1  # 1 / ship weight
 W_INV_WR = W_INV_W + 2  # 1 / (weight R)
-# the horizontal accelerations at which rest surely holds without a vertical input (see
-# ``rest_interval``), set by the first rest span: a flag (0 not set yet), then the bounds
-W_REST_SET = W_INV_W + 3
-W_REST_LO = W_INV_W + 4
-W_REST_HI = W_INV_W + 5
-N_SPAN_WORK = W_INV_W + 6
+# per response slot, the horizontal accelerations [lo, hi] at which the conditions the mode
+# holds surely hold without a vertical input (see ``held_interval``), set with its response
+W_HELD = W_INV_W + 3
+N_SPAN_WORK = W_HELD + 2 * N_RESP_SLOTS
 
 # Numerical constants (documented in docs/theory/solver.md).
 ROOT_TIME_TOL = 1e-12  # [s] width of the bracket that locates an event
