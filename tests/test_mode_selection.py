@@ -10,7 +10,7 @@ from shipblock import ShipBlockSystem
 from shipblock.equations import mode_response
 from shipblock.modes import MODE_NUMBER
 from shipblock.solver import _kernel as K
-from shipblock.solver._layout import ACC_TOL, FORCE_TOL
+from shipblock.solver._layout import ACC_TOL, FORCE_TOL, N_SPAN_WORK
 
 
 def reference_choice(system, y, a, ay, trigger):
@@ -65,6 +65,7 @@ def test_kernel_choice_equals_exhaustive_ranking(seed):
                              mu_s_ship=0.3, mu_k_ship=0.25)
     p = system.to_parameter_vector()  # the kernel passes the array (see select_mode)
     w7 = np.zeros(7)
+    work = np.zeros(N_SPAN_WORK)  # one system: its response cache serves every call
     ms = np.zeros(6, dtype=np.int64)
     n_checked = 0
     for _ in range(150):
@@ -79,7 +80,7 @@ def test_kernel_choice_equals_exhaustive_ranking(seed):
             y[4] = rng.choice([0.4, -0.4])  # just after an impact
         a, ay = rng.normal() * 4.0, rng.normal() * 2.0
         trigger = int(rng.integers(-1, 3))
-        status = K.select_mode(p, y, ms, a, ay, trigger, w7)
+        status = K.select_mode(p, y, ms, a, ay, trigger, w7, work)
         want, consistent = reference_choice(system, y, a, ay, trigger)
         if status == 2:
             continue
@@ -87,3 +88,30 @@ def test_kernel_choice_equals_exhaustive_ranking(seed):
         assert tuple(int(v) for v in ms) == want
         n_checked += 1
     assert n_checked > 100
+
+
+def test_nonrocking_candidates_use_the_response_cache():
+    """At rest a candidate's forces are superposed from the run's response vectors (solved into
+    the cache on first use): the same as solving the mode at (a, G), to rounding."""
+    from shipblock.equations import solve_mode
+    from shipblock.solver._closed_form import response_slot
+    from shipblock.solver._layout import W_RESP_STATE
+
+    system = ShipBlockSystem(ship_mass=4e5, block_mass=1500.0, n_blocks=20, half_width=1.0,
+                             half_height=0.8, mu_s_ground=0.2, mu_k_ground=0.15,
+                             mu_s_ship=0.6, mu_k_ship=0.5)
+    p = system.to_parameter_vector()
+    w7, want = np.zeros(7), np.zeros(7)
+    work = np.zeros(N_SPAN_WORK)
+    ms = np.zeros(6, dtype=np.int64)
+    weight = (system.total_block_mass + system.ship_mass) * system.g
+    scale = np.array([system.g] * 3 + [weight] * 4)
+    for a, ay in [(0.5, 0.3), (-0.7, -1.0), (4.0, 0.0), (-4.0, 1.5)]:
+        status = K.select_mode(p, np.zeros(9), ms, a, ay, -1, w7, work)
+        assert status == 0 and ms[1] == 0  # rest, or the blocks sliding: no rocking
+        slip1, slip2, sig1, sig2 = int(ms[0]), int(ms[2]), float(ms[4]), float(ms[5])
+        assert work[W_RESP_STATE + response_slot(slip1, sig1, slip2, sig2)] == 1.0
+        assert solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, a, system.g + ay, want)
+        assert np.all(np.abs(w7 - want) <= 1e-12 * scale)
+    assert work[W_RESP_STATE + response_slot(1, 1.0, 0, 1.0)] == 1.0  # both slip directions met
+    assert work[W_RESP_STATE + response_slot(1, -1.0, 0, 1.0)] == 1.0

@@ -443,6 +443,52 @@ def response_slot(slip1, sig1, slip2, sig2):
     return 3 * g + s
 
 
+# inlined: mode selection calls it for every non-rocking candidate
+@njit(cache=True, inline="always")
+def mode_response_start(p, work, slip1, sig1, slip2, sig2):
+    """Where the response vectors of a non-rocking mode lie in the run's work array, solved on
+    first use.
+
+    Per :func:`response_slot`, ``work[W_RESP_STATE + slot]`` is 0 (not solved yet), 1 (solved)
+    or 2 (singular), and ``w_a = work[start:start + N_SOLVE_OUT]``, ``w_G`` the next
+    ``N_SOLVE_OUT`` entries, are the mode's :func:`~shipblock.equations.solve_mode` outputs for
+    unit horizontal acceleration (a = 1, G = 0) and unit gravity (a = 0, G = 1): at theta =
+    theta_dot = 0 its output at any input is ``a w_a + G w_G``. Solved with them, the mode's
+    :func:`held_interval`, at ``work[W_HELD + 2 slot]`` and the next entry. The closed-form
+    spans and mode selection (:func:`~shipblock.solver._kernel.select_mode`) share them, so
+    each is solved once per run.
+
+    Parameters
+    ----------
+    p : ndarray
+        Parameter vector.
+    work : ndarray, shape (N_SPAN_WORK,)
+        The run's work array (see :func:`nonrocking_span`).
+    slip1, slip2 : int
+        Ground and ship interface flags (1 slipping).
+    sig1, sig2 : float
+        Their slip directions.
+
+    Returns
+    -------
+    int
+        ``start``, or -1 if the mode is singular.
+    """
+    slot = response_slot(slip1, sig1, slip2, sig2)
+    start = W_RESP + 2 * N_SOLVE_OUT * slot
+    if work[W_RESP_STATE + slot] == 0.0:
+        wa = work[start:start + N_SOLVE_OUT]
+        wg = work[start + N_SOLVE_OUT:start + 2 * N_SOLVE_OUT]
+        ok_a = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
+        ok_g = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)
+        work[W_RESP_STATE + slot] = 1.0 if ok_a and ok_g else 2.0
+        if ok_a and ok_g:
+            work[W_HELD + 2 * slot], work[W_HELD + 2 * slot + 1] = held_interval(
+                slip1, slip2, p[P_G], wa[I_FX], wg[I_FX], wa[I_FY], wg[I_FY], wa[I_SFX],
+                wg[I_SFX], wa[I_SFY], wg[I_SFY], p[P_MUS1], p[P_MUS2], p[P_B], p[P_H])
+    return start if work[W_RESP_STATE + slot] == 1.0 else -1
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs,
                     store, hist, modes, work):
@@ -470,8 +516,9 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         Per-run work array (layout ``W_*`` in :mod:`~shipblock.solver._layout`), zero at the
         start of a run: the event functions; per :func:`response_slot` of the non-rocking
         modes its state (0 not solved yet, 1 solved, 2 singular) and response vectors ``w_a``,
-        ``w_G``, solved on a mode's first span and reused by its later spans in the run (a
-        stick-slip record enters the same few modes thousands of times); the inverse weights
+        ``w_G`` (:func:`mode_response_start`), solved on a mode's first use and reused by its
+        later spans and mode selections in the run (a stick-slip record enters the same few
+        modes thousands of times); the inverse weights
         that scale the event functions, set by the first span; per response slot the
         interval of :func:`held_interval`, set with its response vectors.
 
@@ -490,23 +537,15 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
     n = ax.shape[0]
     slip1, slip2 = ms[MS_SLIP1], ms[MS_SLIP2]
     sig1, sig2 = float(ms[MS_SIG1]), float(ms[MS_SIG2])
+    start = mode_response_start(p, work, slip1, sig1, slip2, sig2)
+    if start < 0:
+        return k, tau, -2, 0.0, peak_xb, peak_xs
     slot = response_slot(slip1, sig1, slip2, sig2)
-    start = W_RESP + 2 * N_SOLVE_OUT * slot
     wa = work[start:start + N_SOLVE_OUT]
     wg = work[start + N_SOLVE_OUT:start + 2 * N_SOLVE_OUT]
     g = work[W_G:W_G + N_EVENTS]
     grav = p[P_G]
     mus1, mus2, B, H = p[P_MUS1], p[P_MUS2], p[P_B], p[P_H]
-    if work[W_RESP_STATE + slot] == 0.0:
-        ok_a = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
-        ok_g = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)
-        work[W_RESP_STATE + slot] = 1.0 if ok_a and ok_g else 2.0
-        if ok_a and ok_g:
-            work[W_HELD + 2 * slot], work[W_HELD + 2 * slot + 1] = held_interval(
-                slip1, slip2, grav, wa[I_FX], wg[I_FX], wa[I_FY], wg[I_FY], wa[I_SFX], wg[I_SFX],
-                wa[I_SFY], wg[I_SFY], mus1, mus2, B, H)
-    if work[W_RESP_STATE + slot] == 2.0:
-        return k, tau, -2, 0.0, peak_xb, peak_xs
     ub_a, us_a, fx_a, fy_a, Fx_a, Fy_a = wa[I_XB_DD], wa[I_XS_DD], wa[I_FX], wa[I_FY], wa[I_SFX], wa[I_SFY]
     ub_g, us_g, fx_g, fy_g, Fx_g, Fy_g = wg[I_XB_DD], wg[I_XS_DD], wg[I_FX], wg[I_FY], wg[I_SFX], wg[I_SFY]
     # without a vertical input, the held conditions surely hold for a in [lo, hi]

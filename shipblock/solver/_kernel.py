@@ -38,7 +38,7 @@ from shipblock.equations import (
 )
 from shipblock.impact import apply_impact
 from shipblock.modes import MODE_NUMBER, EventKind, Failure
-from shipblock.solver._closed_form import nonrocking_span
+from shipblock.solver._closed_form import mode_response_start, nonrocking_span
 from shipblock.solver._dopri import DP_A, DP_C, DP_E, DP_ERROR_ORDER
 from shipblock.solver._events import event_functions, rearm, rotation_event
 from shipblock.solver._ground import ground_motion_at
@@ -428,7 +428,7 @@ CANDIDATE_KEYS, CANDIDATE_COUNTS = _candidate_order()
 
 
 @njit(cache=True, _nrt=False)
-def select_mode(p, y, ms, a, b, trigger, w7):
+def select_mode(p, y, ms, a, b, trigger, w7, work):
     """Choose the next mode among the candidates consistent with the velocities.
 
     Candidates: an interface with a nonzero slip velocity keeps slipping that way; one at zero
@@ -443,8 +443,13 @@ def select_mode(p, y, ms, a, b, trigger, w7):
 
     The candidates are visited in that order of preference (by number of new motions, then
     trigger, then mode number; tabulated in ``CANDIDATE_KEYS``), so the first consistent one is
-    the choice and the search stops there: after most events one or two candidates are solved
-    instead of up to 27.
+    the choice and the search stops there: after most events one or two candidates are evaluated
+    instead of up to 27. A non-rocking candidate is not solved at all: it exists only with the
+    block at theta = theta_dot = 0, where its accelerations and forces are ``a w_a + G w_G``
+    from the response vectors the closed-form spans keep per run (solved here on the mode's
+    first use, see :func:`~shipblock.solver._closed_form.mode_response_start`). After an event
+    between sliding and rest modes, the common event of a stick-slip record, no equations are
+    solved.
 
     Parameters
     ----------
@@ -462,7 +467,11 @@ def select_mode(p, y, ms, a, b, trigger, w7):
     trigger : int
         Interface whose event this is: 0 ground, 1 rocking, 2 ship, -1 none.
     w7 : ndarray, shape (N_SOLVE_OUT,)
-        Work array for :func:`~shipblock.equations.solve_mode`.
+        Work array: a candidate's :func:`~shipblock.equations.solve_mode` output.
+    work : ndarray, shape (N_SPAN_WORK,)
+        The run's work array of the closed-form spans (see
+        :func:`~shipblock.solver._closed_form.nonrocking_span`), zero at the start of a run:
+        its response vectors of the non-rocking modes.
 
     Returns
     -------
@@ -489,12 +498,22 @@ def select_mode(p, y, ms, a, b, trigger, w7):
         key2 = order[jc] // 512
         mode = (order[jc] // 32) % 16
         slip1, sig1, new1, rock, s, newr, slip2, sig2, new2 = candidate_options(idx, vb, rot, vs)
-        # solve_mode without its wrapper's call: this runs for one to three candidates per event
-        c, sn = pivot_geometry(p, th, float(s), rock)
-        ok = solve_mode_at(p, slip1, rock, slip2, float(s), float(sig1), float(sig2), c, sn, om,
-                           a, G, w7)
-        if not ok:
-            continue
+        if rock == 0:
+            # a non-rocking candidate exists only at theta = theta_dot = 0 (candidate_options),
+            # where its output is linear in (a, G): superposed as the closed-form spans do
+            start = mode_response_start(p, work, slip1, float(sig1), slip2, float(sig2))
+            if start < 0:
+                continue  # singular, as solve_mode_at would find
+            for i in range(N_SOLVE_OUT):
+                w7[i] = work[start + i] * a + work[start + N_SOLVE_OUT + i] * G
+        else:
+            # solve_mode without its wrapper's call: this runs for one to three candidates per
+            # event
+            c, sn = pivot_geometry(p, th, float(s), rock)
+            ok = solve_mode_at(p, slip1, rock, slip2, float(s), float(sig1), float(sig2), c, sn,
+                               om, a, G, w7)
+            if not ok:
+                continue
         fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
         viol = 0.0
         separate = fy <= 0.0 or Fy <= 0.0
@@ -605,7 +624,8 @@ summary, y_init
     g0, g1, gw : ndarray, shape (N_EVENTS,)
         Work: the event functions at both ends of a step and in the root search.
     span_work : ndarray, shape (N_SPAN_WORK,)
-        Work of the closed-form spans.
+        Work of the closed-form spans, zero on entry; mode selection shares its response
+        vectors.
     armed : ndarray of bool, shape (N_EVENTS,)
         Work: which events may fire (all True on entry).
     ms : ndarray of int, shape (6,)
@@ -634,7 +654,7 @@ summary, y_init
     k = 0
     tau = 0.0
     a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, 0, ONE_SIDED_DT, dt)
-    status = select_mode(p_vec, y, ms, a_next, b_next, -1, w7)
+    status = select_mode(p_vec, y, ms, a_next, b_next, -1, w7, span_work)
     if status == 2:
         failure = Failure.SEPARATION
         failure_time = 0.0
@@ -836,7 +856,7 @@ summary, y_init
                 old0, old1, old2, old3, old4, old5 = ms[0], ms[1], ms[2], ms[3], ms[4], ms[5]
                 a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + ONE_SIDED_DT,
                                                   dt)
-                status = select_mode(p_vec, y, ms, a_next, b_next, trigger, w7)
+                status = select_mode(p_vec, y, ms, a_next, b_next, trigger, w7, span_work)
                 if status == 2:
                     failure = Failure.SEPARATION
                     kind = EventKind.SEPARATION
