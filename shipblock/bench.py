@@ -389,7 +389,7 @@ def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campai
                   f"{key} {100 * r[f'fraction_{key}']:.0f} % of the time); "
                   f"{r['runs_per_s_at_target_length']:.3g} runs/s of {TARGET_SAMPLES} samples "
                   f"(target {target}: {_verdict(r['runs_per_s_at_target_length'] >= target)})\n")
-    scaling = batch_scaling(rocking_system(), records, 0.3, n_copies=4 if quick else 12)
+    scaling = batch_scaling(rocking_system(), records, 0.3, n_copies=4 if quick else 24)
     control = machine_scaling(0.1 if quick else 0.25)
     scaling["machine_speedup"] = control["speedup"]
     results["batch_scaling"] = scaling

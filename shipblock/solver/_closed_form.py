@@ -489,7 +489,9 @@ def mode_response_start(p, work, slip1, sig1, slip2, sig2):
     return start if work[W_RESP_STATE + slot] == 1.0 else -1
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+# inlined into the kernel's loop: a call passed some 75 machine words of arguments at every
+# event, a few per cent of a stick-slip record's time
+@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs,
                     store, hist, modes, work):
     """Advance a non-rocking mode sample by sample until an event or the end of the record.

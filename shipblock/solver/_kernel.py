@@ -597,7 +597,9 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
               vectors[4], stages, w7[0], w7[1], K, g[0], g[1], g[2], span_work, armed, ms)
 
 
-@njit(cache=True, _nrt=False)
+# IEEE division (error_model="numpy") as in the closed-form span inlined here: the default
+# would add a zero test before every division
+@njit(cache=True, error_model="numpy", _nrt=False)
 def integrate(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes,
               ev_t, ev_kft, summary, y_init, y, y1, yr, ytmp, f_end, stages, w7, w7b, K, g0, g1,
               gw, span_work, armed, ms):
