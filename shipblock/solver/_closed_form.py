@@ -590,23 +590,15 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
     Fx0 = Fx_a * a0 + Fx_g * G0
     ub0 = ub_a * a0 + ub_g * G0
     us0 = us_a * a0 + us_g * G0
-    fx_gg, Fx_gg, ub_gg, us_gg = fx_g * grav, Fx_g * grav, ub_g * grav, us_g * grav
     while k < n - 1:
         h = dt - tau
         a1 = sh * ax[k + 1]
         b1 = sv * ay[k + 1] if has_ay else 0.0
         G1 = grav + b1
-        if has_ay:
-            fx1 = fx_a * a1 + fx_g * G1
-            Fx1 = Fx_a * a1 + Fx_g * G1
-            ub1 = ub_a * a1 + ub_g * G1
-            us1 = us_a * a1 + us_g * G1
-        else:
-            # G1 = g exactly: the same values with the products in g taken once
-            fx1 = fx_a * a1 + fx_gg
-            Fx1 = Fx_a * a1 + Fx_gg
-            ub1 = ub_a * a1 + ub_gg
-            us1 = us_a * a1 + us_gg
+        fx1 = fx_a * a1 + fx_g * G1
+        Fx1 = Fx_a * a1 + Fx_g * G1
+        ub1 = ub_a * a1 + ub_g * G1
+        us1 = us_a * a1 + us_g * G1
         vb0 = y[Y_VB]
         vs0 = y[Y_VS]
         # Cheap screen at the end of the interval: force-type event functions are linear (or
