@@ -129,3 +129,22 @@ def test_bench_arguments_are_checked(argv, needle, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert needle in err and err.count("\n") == 1
+
+
+def test_samples_counted_stop_where_a_run_fails():
+    """A run that overturns integrates only up to its failure: only those samples count."""
+    from shipblock import ShipBlockSystem, simulate_batch
+
+    dt = 0.01
+    t = np.arange(2000) * dt
+    pulse = np.where(t < 0.5, 30.0, 0.0)  # overturns the slender blocks early
+    quiet = 0.5 * np.sin(2 * np.pi * t)  # never moves them
+    system = ShipBlockSystem(ship_mass=5e6, block_mass=1500.0, n_blocks=150, half_width=0.12,
+                             half_height=0.8, mu_s_ground=0.8, mu_k_ground=0.8, mu_s_ship=0.8,
+                             mu_k_ship=0.8)
+    summ = simulate_batch(system, [(pulse, None), (quiet, None)], dt, [(0, 0, 1, 1), (1, 0, 1, 1)])
+    assert summ["failure"][0] != 0 and summ["failure"][1] == 0
+    n = bench.integrated_samples(summ, np.array([dt, dt]))
+    failed_at = summ["failure_time"][0]
+    assert n == pytest.approx(failed_at / dt + 1 + t.size, rel=1e-12)
+    assert n < 1.5 * t.size  # not the 2 x 2000 input samples
