@@ -157,10 +157,8 @@ def _load_stream(paths_or_stream, units, fmt, read_kwargs) -> Stream:
         return stream
     if isinstance(paths_or_stream, Trace):
         return _load_stream(Stream([paths_or_stream]), units, fmt, read_kwargs)
-    if isinstance(paths_or_stream, (str, os.PathLike)):
-        paths = [paths_or_stream]
-    else:
-        paths = list(paths_or_stream)
+    single = isinstance(paths_or_stream, (str, os.PathLike))
+    paths = [paths_or_stream] if single else list(paths_or_stream)
     if not paths:
         raise RecordError("<no files>", "no record files given")
     stream = Stream()

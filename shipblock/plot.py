@@ -356,10 +356,8 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
         names = [limit_state] if isinstance(limit_state, str) else list(limit_state)
     scaled = "im_level" in ds.coords
     x_obs_si = ds["im_level"].values if scaled else None
-    if scaled:
-        x_max = float(np.nanmax(x_obs_si)) * 1.15
-    else:
-        x_max = float(np.nanmax(ds["achieved_im"].values)) * 1.15
+    # the axis covers the levels run (IDA) or the intensities achieved (cloud)
+    x_max = 1.15 * float(np.nanmax(x_obs_si if scaled else ds["achieved_im"].values))
     x_si = np.linspace(x_max / 400, x_max, 400)
     x_plot, xlabel, _ = _im_axis(ds, x_si)
     colours = [f"C{i}" for i in range(10)]

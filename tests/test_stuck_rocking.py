@@ -27,6 +27,7 @@ from shipblock.equations import (
     stuck_rocking_gain,
     stuck_rocking_rates,
 )
+from shipblock.solver._fused import fma
 from shipblock.solver._kernel import advance, advance_general, error_norm
 from shipblock.solver._layout import (
     MS_ROCK,
@@ -39,7 +40,6 @@ from shipblock.solver._layout import (
     Y_WIN,
     parameter_tuple,
 )
-from shipblock.solver._fused import fma
 from shipblock.solver._stuck_rocking import (
     SHORT_ANGLE,
     SMALL_ANGLE,

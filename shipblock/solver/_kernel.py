@@ -55,7 +55,6 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     EV_G_STICK,
     EV_IMPACT,
     EV_OVERTURN,
-    EV_ROTATION_PEAK,
     EV_S_SLIP,
     EV_S_STICK,
     EV_SEP_G,
@@ -255,7 +254,8 @@ def start_slope(e, ms, y, acc_b, acc_s):
 
 @njit(cache=True, inline="always")
 def has_slope(e):
-    return e == EV_G_SLIP or e == EV_S_SLIP or e == EV_IMPACT
+    """Whether event ``e`` has a slope at the ends of a step (a velocity or the rotation)."""
+    return e in (EV_G_SLIP, EV_S_SLIP, EV_IMPACT)
 
 
 @njit(cache=True, _nrt=False)
@@ -268,9 +268,7 @@ def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages,
     """
     advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, True, 1.0,
             1.0)
-    if e == EV_ROTATION_PEAK:
-        return y1[Y_OM] if y0[Y_OM] > 0.0 else -y1[Y_OM]
-    if e == EV_IMPACT or e == EV_OVERTURN:
+    if e in (EV_IMPACT, EV_OVERTURN):
         return rotation_event(p, ms, e, y1[Y_TH])
     event_values(p, ms, y1, k, tau + h, dt, ax, ay, has_ay, sh, sv, g, w7)
     return g[e]
@@ -306,10 +304,8 @@ def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has
     for _ in range(200):
         if hi - lo <= ROOT_TIME_TOL:
             break
-        if g_lo == g_hi:
-            mid = 0.5 * (lo + hi)
-        else:
-            mid = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+        # a secant step, or the midpoint when the ends are level
+        mid = 0.5 * (lo + hi) if g_lo == g_hi else hi - g_hi * (hi - lo) / (g_hi - g_lo)
         # keep the trial strictly inside, and fall back to bisection near the ends
         width = hi - lo
         if not (lo + 0.01 * width < mid < hi - 0.01 * width):

@@ -31,7 +31,6 @@ EV_S_SLIP = 6  # ship slides: sigma2 * v_s
 EV_SEP_G = 7  # fy > 0
 EV_SEP_S = 8  # Fy > 0
 N_EVENTS = 9
-EV_ROTATION_PEAK = 9  # not a transition: theta_dot changes sign (locates peak rotations)
 #: Order in which simultaneous events are taken: failures first, then velocity events.
 EVENT_PRIORITY = np.array(
     [EV_SEP_G, EV_SEP_S, EV_OVERTURN, EV_IMPACT, EV_G_SLIP, EV_S_SLIP, EV_UPLIFT, EV_G_STICK,

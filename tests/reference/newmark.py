@@ -91,10 +91,8 @@ def newmark_slip(a, ay, dt, mu, g=9.80665):
                 if t_stop is not None:
                     vc = 0.0
                     at, Gt = a0 + da * tau, G0 + dG * tau
-                    if abs(at) <= mu * Gt:
-                        sigma = 0
-                    else:
-                        sigma = -1 if at > 0 else 1
+                    # stays stuck if friction can hold it, else slides back the way it is pushed
+                    sigma = 0 if abs(at) <= mu * Gt else (-1 if at > 0 else 1)
         x[k + 1] = xc
         v[k + 1] = vc
     return x, v
