@@ -410,7 +410,8 @@ def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campai
         results[f"{key}_runs"] = r
         target = TARGETS[f"{key}_runs_per_s"]
         out.write(f"{key + ' runs':<18}: {r['runs_per_s']:.3g} runs/s on {r['cores']} cores "
-                  f"({r['cases']} runs of {r['samples_per_run']:.0f} samples on average, "
+                  f"({r['cases']} runs of {r['samples_per_run']:.0f} samples integrated on average, "
+                  f"{r['failures']} failing, "
                   f"{key} {100 * r[f'fraction_{key}']:.0f} % of the time); "
                   f"{r['runs_per_s_at_target_length']:.3g} runs/s of {TARGET_SAMPLES} samples "
                   f"(target {target}: {_verdict(r['runs_per_s_at_target_length'] >= target)})\n")
