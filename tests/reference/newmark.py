@@ -91,7 +91,7 @@ def newmark_slip(a, ay, dt, mu, g=9.80665):
                 if t_stop is not None:
                     vc = 0.0
                     at, Gt = a0 + da * tau, G0 + dG * tau
-                    # stays stuck if friction can hold it, else slides back the way it is pushed
+                    # stays stuck if friction can hold it, else slides against the ground acceleration
                     sigma = 0 if abs(at) <= mu * Gt else (-1 if at > 0 else 1)
         x[k + 1] = xc
         v[k + 1] = vc
