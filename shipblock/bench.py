@@ -392,7 +392,7 @@ def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campai
     out.write(f"sliding-dominated : {slide['samples_per_s']:.3g} samples/s per core "
               f"(sliding {100 * slide['fraction_sliding']:.0f} % of the time)\n")
     rock = throughput(rocking_system(), records, scale=0.3)
-    rock["peak_rotation_error"] = rocking_accuracy(rocking_system(), records[:2], 0.3)
+    rock["peak_rotation_error"] = rocking_accuracy(rocking_system(), records, 0.3)
     results["rocking"] = rock
     out.write(f"rocking-dominated : {rock['samples_per_s']:.3g} samples/s per core "
               f"(rocking {100 * rock['fraction_rocking']:.0f} % of the time; "
