@@ -48,8 +48,9 @@ from shipblock.equations import (
     solve_mode,
 )
 from shipblock.modes import MODE_NUMBER
-from shipblock.solver._events import event_functions
+from shipblock.solver._events import event_functions, rearm
 from shipblock.solver._ground import ground_motion_at
+from shipblock.solver._history import store_sample
 from shipblock.solver._layout import (
     EV_G_SLIP,
     EV_G_STICK,
@@ -69,7 +70,6 @@ from shipblock.solver._layout import (
     MS_SLIP2,
     N_EVENTS,
     N_STATE,
-    REARM_TOL,
     ROOT_TIME_TOL,
     W_G,
     W_HELD,
@@ -685,26 +685,10 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         fx0, Fx0, ub0, us0 = fx1, Fx1, ub1, us1
         if not all_armed:
             event_functions(p, ms, y, fx1, fy_a * a1 + fy_g * G1, Fx1, Fy_a * a1 + Fy_g * G1, g)
-            all_armed = True
-            for e in range(N_EVENTS):
-                if not armed[e]:
-                    if g[e] > REARM_TOL:
-                        armed[e] = True
-                    else:
-                        all_armed = False
+            all_armed = rearm(armed, g)
         if store:
-            _store(p, y, hist, modes, k, mode)
+            store_sample(p, ms, y, hist, modes, k, mode)
     return k, tau, -1, time_in_mode, peak_xb, peak_xs
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
-def _store(p, y, hist, modes, k, mode):
-    """History column of a non-rocking sample (theta = 0): the state, its energies and mode."""
-    for i in range(N_STATE):
-        hist[i, k] = y[i]
-    hist[H_KIN, k] = kinetic_energy(p, 0.0, 1.0, 0, y[Y_VB], 0.0, y[Y_VS])
-    hist[H_POT, k] = 0.0  # theta = 0: the potential energy's reference
-    modes[k] = mode
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
