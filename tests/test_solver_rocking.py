@@ -69,12 +69,15 @@ def free_rocking_reference(theta0, alpha, e, J, W, n_impacts):
     return np.array(times), np.array(amps)
 
 
+@pytest.mark.parametrize("tolerances", [TIGHT, {}], ids=["tight", "default"])
 @pytest.mark.parametrize("ship_mass,n", [(1e-6, 1), (2e4, 4)])
-def test_free_rocking_impact_times(ship_mass, n):
+def test_free_rocking_impact_times(ship_mass, n, tolerances):
     """Housner (1963) free rocking (ship mass -> 0), and the compound block + ship pendulum.
 
     Impact times from the energy quadrature with the system restitution; the ship is lumped into
-    J = nI + (nm+4M)R^2 and W = (nm+2M) g R (notes section 5).
+    J = nI + (nm+4M)R^2 and W = (nm+2M) g R (notes section 5). At the default tolerance the
+    rocking is stepped a sample at a time and the impacts are located inside those steps
+    (``locate_impact``); at the tight one, by the kernel's own root search.
     """
     system = rocking_system(ship_mass=ship_mass, n=n)
     alpha = system.critical_angle
@@ -84,7 +87,8 @@ def test_free_rocking_impact_times(ship_mass, n):
         assert e == pytest.approx(1 - 1.5 * math.sin(alpha) ** 2, abs=1e-9)  # Housner
     dt = 0.01
     theta0 = 0.6 * alpha
-    res = simulate(system, np.zeros(800), None, dt, initial_state=(0, theta0, 0, 0, 0, 0), **TIGHT)
+    res = simulate(system, np.zeros(800), None, dt, initial_state=(0, theta0, 0, 0, 0, 0),
+                   **tolerances)
     impacts = np.array([ev.time for ev in res.events_of("impact")])
     ref, amps = free_rocking_reference(theta0, alpha, e, J, W, 12)
     assert len(impacts) >= 12
@@ -327,7 +331,29 @@ def test_mirror_symmetry_all_modes():
 
 
 def test_rocking_converges_as_tolerance_tightens():
-    """Peak rotation and residual slips converge as rtol decreases (no hidden fixed-step error)."""
+    """Rocking results converge with the tolerance: no hidden fixed-step error.
+
+    Free rocking of the compound system across long sample intervals (dt = 0.5 s), where the
+    step is limited by the tolerance alone: the error of the first eight impact times against
+    the energy quadrature falls in proportion to rtol. On a random record visiting all eight
+    modes (1-in-200-s samples, where a step per sample already meets every tolerance here)
+    every tolerance agrees with a tight run to far below any engineering interest; what is
+    left there is rounding amplified by ~900 impacts (~3e-11).
+    """
+    system = rocking_system(ship_mass=2e4, n=4)
+    alpha = system.critical_angle
+    J, W = rocking_constants(system)
+    theta0 = 0.6 * alpha
+    ref, _ = free_rocking_reference(theta0, alpha, system.effective_restitution, J, W, 8)
+    errors = []
+    for rtol in (1e-5, 1e-7, 1e-9):
+        res = simulate(system, np.zeros(16), None, 0.5, initial_state=(0, theta0, 0, 0, 0, 0),
+                       rtol=rtol, atol=rtol * 1e-2)
+        impacts = np.array([ev.time for ev in res.events_of("impact")])[:8]
+        errors.append(np.abs(impacts - ref).max())
+        assert errors[-1] < 100 * rtol
+    assert errors[1] < errors[0] / 30 and errors[2] < errors[1] / 30
+
     a, ay, dt = random_record(3, n=2000)
     system = all_modes_system()
     peaks = []
@@ -335,9 +361,7 @@ def test_rocking_converges_as_tolerance_tightens():
         r = simulate(system, a, ay, dt, rtol=rtol, atol=rtol * 1e-2)
         peaks.append((r.summary["peak_rotation"], r.summary["residual_block_slip"]))
     peaks = np.array(peaks)
-    err = np.abs(peaks[:-1] - peaks[-1]).max(axis=1)
-    assert err[-1] < 1e-6
-    assert err[-1] <= err[0] + 1e-12
+    assert np.abs(peaks[:-1] - peaks[-1]).max() < 1e-9
 
 
 def test_invalid_inputs_are_named():

@@ -43,8 +43,10 @@ from shipblock.solver._layout import (
 from shipblock.solver._stuck_rocking import (
     SHORT_ANGLE,
     SMALL_ANGLE,
+    locate_impact,
     short_angle_sincos,
     small_angle_sincos,
+    stuck_step,
 )
 from shipblock.system import P_G, P_M, P_NM, P_R, P_THC
 
@@ -194,3 +196,84 @@ def test_mode_3_step_equals_general_step(first_known):
         # rounding, i.e. relative to the sum's terms, not to the estimate
         assert abs(err_a - err_b) <= 1e-6 * max(err_b, 1e-3 * (1 + err_b))
     assert n_large > 10  # the large-rotation branch was exercised
+
+
+def _general_theta(p, ms, y0, k, tau, h, dt, ax, ay):
+    """theta, theta_dot and input work after the general step of ``h`` from ``y0``."""
+    n = y0.size
+    y1 = np.empty(n)
+    advance_general(p, ms, y0, k, tau, h, dt, ax, ay, True, 1.0, 1.0, y1, np.zeros((7, n)),
+                    np.empty(n), np.empty(N_SOLVE_OUT), False)
+    return y1[Y_TH], y1[Y_OM], y1[Y_WIN]
+
+
+@pytest.mark.parametrize("from_zero", [False, True])
+def test_impact_is_located_at_the_integrators_own_root(from_zero):
+    """locate_impact returns where the step's own solution reaches theta = 0, and the state there.
+
+    Reference: bisection to 1e-15 s on the general step of the kernel (the 7x7 solve per stage)
+    from the same start, taken over the trial length, which is what the kernel's root search
+    does. Either the usual crossing (theta heading into zero) or, just after an impact, the
+    rotation leaving zero and falling back within the step (``from_zero``): the root sought is
+    then the second one, not the start.
+    """
+    rng = np.random.default_rng(5 + from_zero)
+    checked = 0
+    for _ in range(200):
+        system = _random_system(rng)
+        p_vec = system.to_parameter_vector()
+        p = parameter_tuple(p_vec)
+        s = float(rng.choice([-1.0, 1.0]))
+        dt = float(rng.choice([0.005, 0.01, 0.02]))
+        ax = rng.uniform(-3.0, 3.0, 3)
+        ay = rng.uniform(-2.0, 2.0, 3)
+        gain = stuck_rocking_gain(p)
+        tau = float(rng.choice([0.0, rng.uniform(0.0, 0.8) * dt]))
+        h = dt - tau
+        f0 = tau / dt
+        a0, da, b0, db = ax[1], ax[2] - ax[1], ay[1], ay[2] - ay[1]
+        # restoring acceleration scale at theta = 0, to pick motions that reach zero in the step
+        pull = gain * (p[P_G] * math.sin(p[P_THC]) + 3.0)
+        if from_zero:
+            th0, om0 = 0.0, s * rng.uniform(0.05, 0.4) * pull * h
+        else:
+            om0 = -s * rng.uniform(0.5, 5.0) * pull * h
+            th0 = -om0 * rng.uniform(0.2, 0.9) * h
+        phi = p[P_THC] - s * th0
+        c, sn = math.cos(phi), math.sin(phi)
+        al, pw = stuck_rocking_rates(p, gain, c, sn, s, om0, a0 + da * f0, b0 + db * f0)
+        th1, om1, w1, al1, *_ = stuck_step(p, gain, s, c, sn, th0, om0, 0.0, al, pw, a0, da, b0,
+                                           db, f0, 1.0 - f0, h)
+        if not s * th1 < 0.0:
+            continue  # no impact within this step
+        ok, t, th_i, om_i, w_i, _ = locate_impact(p, gain, s, c, sn, th0, om0, 0.0, al, pw, th1,
+                                                  om1, al1, a0, da, b0, db, f0, h, dt)
+        assert ok
+        ms = np.zeros(6, np.int64)
+        ms[MS_ROCK] = 1
+        ms[MS_S] = int(s)
+        y0 = np.zeros(N_STATE)
+        y0[Y_TH] = th0
+        y0[Y_OM] = om0
+        # bisection on the general step: theta of the step's solution changes sign in (lo, hi)
+        lo = 0.0
+        if from_zero:
+            # past the turn: theta_dot has the sign of the return there
+            lo = 0.5 * t
+            assert s * _general_theta(p, ms, y0, 1, tau, lo, dt, ax, ay)[0] > 0.0
+        hi = h
+        while hi - lo > 1e-15:
+            mid = 0.5 * (lo + hi)
+            if s * _general_theta(p, ms, y0, 1, tau, mid, dt, ax, ay)[0] > 0.0:
+                lo = mid
+            else:
+                hi = mid
+        assert abs(t - lo) <= 2e-12
+        th_r, om_r, w_r = _general_theta(p, ms, y0, 1, tau, t, dt, ax, ay)
+        assert abs(th_i) <= 1e-15 + 1e-12 * abs(om0)
+        assert abs(th_r) <= 2e-12 * abs(om_r)  # the reference's own theta at t: near zero too
+        assert abs(om_i - om_r) <= 1e-12 * (abs(om0) + abs(al) * h)
+        assert abs(w_i - w_r) <= 1e-11 * abs(w_r) + 1e-6
+        assert s * om_i < 0.0  # arriving at the impact
+        checked += 1
+    assert checked > 40

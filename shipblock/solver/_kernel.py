@@ -675,6 +675,7 @@ summary, y_init
         if ms[MS_ROCK] == 0:
             # rest and sliding: closed form, sample by sample, up to the next event
             k_before = k
+            span_impact = False
             k, tau, best_e, span_time, peak_xb, peak_xs = nonrocking_span(
                 p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs, store,
                 hist, modes, span_work)
@@ -689,124 +690,130 @@ summary, y_init
                 failure_time = k * dt + tau
                 break
         else:
-            if tau == 0.0 and h_rock >= dt and is_stuck_rocking(ms, y):
-                # the usual rocking mode from a sample on: whole samples while nothing happens
+            span_impact = False
+            if h_rock >= dt and is_stuck_rocking(ms, y):
+                # the usual rocking mode: to the next sample and on by whole samples while
+                # nothing happens, or up to an impact
                 k_before = k
-                k, span_time, peak_th, peak_th_time = stuck_rocking_span(
-                    p, ms, y, k, dt, ax, ay, has_ay, sh, sv, rtol, atol, armed, g0, g1, peak_th,
-                    peak_th_time, store, hist, modes, mode_number(ms))
-                if k != k_before:
+                k, tau, span_impact, span_time, peak_th, peak_th_time = stuck_rocking_span(
+                    p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol, armed, g0, g1,
+                    peak_th, peak_th_time, store, hist, modes, mode_number(ms))
+                if span_time > 0.0:
                     summary[S_MODE_TIME + mode_number(ms) - 1] += span_time
-                    events_here = 0
                     fsal = False
-                    if k >= n - 1:
-                        break
-                # (the step the span stopped before is taken below)
-            # rocking: error-controlled Dormand-Prince steps within the sample interval, where
-            # the input is linear (a step across a sample would straddle a kink of the input)
-            remaining = dt - tau
-            h = min(h_rock, remaining)
-            err = advance(p, ms, y, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
-                          fsal, rtol, atol)
-            fsal = True  # stages[0] holds f(y) now, whatever happens to this step
-            if err < 0.0:
-                failure = Failure.SOLVER_ERROR
-                failure_time = k * dt + tau
-                break
-            if err > 1.0:
-                h_rock = h * max(MIN_FACTOR, SAFETY * err ** (-1.0 / (DP_ERROR_ORDER + 1)))
-                if h_rock < MIN_STEP:
+                if k != k_before:
+                    events_here = 0
+                if k >= n - 1:
+                    break
+                if span_impact:
+                    best_e = EV_IMPACT  # applied below; the span has advanced to it
+                # (otherwise the step the span stopped before is taken below)
+            if not span_impact:
+                # rocking: error-controlled Dormand-Prince steps within the sample interval, where
+                # the input is linear (a step across a sample would straddle a kink of the input)
+                remaining = dt - tau
+                h = min(h_rock, remaining)
+                err = advance(p, ms, y, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
+                              fsal, rtol, atol)
+                fsal = True  # stages[0] holds f(y) now, whatever happens to this step
+                if err < 0.0:
                     failure = Failure.SOLVER_ERROR
                     failure_time = k * dt + tau
                     break
-                continue
-            # slopes at both ends (first and last stage) for the interpolants and event checks
-            d_start_b = stages[0, Y_VB]
-            d_start_s = stages[0, Y_VS]
-            al0 = stages[0, Y_OM]
-            al1 = stages[6, Y_OM]
-            for i in range(N_STATE):
-                f_end[i] = stages[6, i]
-            # the last stage solved the equations at (t + h, y1): its forces give the events
-            for i in range(N_SOLVE_OUT):
-                w7b[i] = w7[i]
-            event_functions(p, ms, y1, w7b[I_FX], w7b[I_FY], w7b[I_SFX], w7b[I_SFY], g1)
-            best_h = h + 1.0
-            best_e = -1
-            for ie in range(N_EVENTS):
-                e = EVENT_PRIORITY[ie]
-                if not armed[e]:
+                if err > 1.0:
+                    h_rock = h * max(MIN_FACTOR, SAFETY * err ** (-1.0 / (DP_ERROR_ORDER + 1)))
+                    if h_rock < MIN_STEP:
+                        failure = Failure.SOLVER_ERROR
+                        failure_time = k * dt + tau
+                        break
                     continue
-                lo = 0.0
-                g_lo = g0[e]
-                hi = h
-                g_hi = g1[e]
-                fired = False
-                if g1[e] < 0.0:
-                    fired = True
-                    if g0[e] <= 0.0:
-                        # started on the boundary: look for the interior maximum first
-                        g_lo = 0.0
-                        if has_slope(e):
-                            d0 = start_slope(e, ms, y, d_start_b, d_start_s)
-                            d1 = event_slope(e, ms, y1, w7b)
-                            u, _ = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
-                            if u > 0.0:
+                # slopes at both ends (first and last stage) for the interpolants and event checks
+                d_start_b = stages[0, Y_VB]
+                d_start_s = stages[0, Y_VS]
+                al0 = stages[0, Y_OM]
+                al1 = stages[6, Y_OM]
+                for i in range(N_STATE):
+                    f_end[i] = stages[6, i]
+                # the last stage solved the equations at (t + h, y1): its forces give the events
+                for i in range(N_SOLVE_OUT):
+                    w7b[i] = w7[i]
+                event_functions(p, ms, y1, w7b[I_FX], w7b[I_FY], w7b[I_SFX], w7b[I_SFY], g1)
+                best_h = h + 1.0
+                best_e = -1
+                for ie in range(N_EVENTS):
+                    e = EVENT_PRIORITY[ie]
+                    if not armed[e]:
+                        continue
+                    lo = 0.0
+                    g_lo = g0[e]
+                    hi = h
+                    g_hi = g1[e]
+                    fired = False
+                    if g1[e] < 0.0:
+                        fired = True
+                        if g0[e] <= 0.0:
+                            # started on the boundary: look for the interior maximum first
+                            g_lo = 0.0
+                            if has_slope(e):
+                                d0 = start_slope(e, ms, y, d_start_b, d_start_s)
+                                d1 = event_slope(e, ms, y1, w7b)
+                                u, _ = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
+                                if u > 0.0:
+                                    gm = event_after(e, p, ms, y, k, tau, u * h, dt, ax, ay, has_ay,
+                                                     sh, sv, yr, stages, ytmp, w7, gw)
+                                    if gm > 0.0:
+                                        lo = u * h
+                                        g_lo = gm
+                    elif has_slope(e) and g0[e] > 0.0:
+                        d0 = start_slope(e, ms, y, d_start_b, d_start_s)
+                        d1 = event_slope(e, ms, y1, w7b)
+                        if d0 < 0.0 and d1 > 0.0:
+                            u, vmin = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
+                            if u > 0.0 and vmin < 0.0:
                                 gm = event_after(e, p, ms, y, k, tau, u * h, dt, ax, ay, has_ay,
                                                  sh, sv, yr, stages, ytmp, w7, gw)
-                                if gm > 0.0:
-                                    lo = u * h
-                                    g_lo = gm
-                elif has_slope(e) and g0[e] > 0.0:
-                    d0 = start_slope(e, ms, y, d_start_b, d_start_s)
-                    d1 = event_slope(e, ms, y1, w7b)
-                    if d0 < 0.0 and d1 > 0.0:
-                        u, vmin = hermite_extremum(g0[e], d0 * h, g1[e], d1 * h)
-                        if u > 0.0 and vmin < 0.0:
-                            gm = event_after(e, p, ms, y, k, tau, u * h, dt, ax, ay, has_ay,
-                                             sh, sv, yr, stages, ytmp, w7, gw)
-                            if gm < 0.0:
-                                fired = True
-                                hi = u * h
-                                g_hi = gm
-                if fired:
-                    if g_lo > 0.0:
-                        guess = -1.0
-                        if e == EV_IMPACT:
-                            # first guess: the root of the step's quintic interpolant of theta
-                            c0, c1, c2, c3, c4, c5 = quintic_hermite(
-                                y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h)
-                            u = bracketed_root(c0, c1, c2, c3, c4, c5, lo / h, hi / h, False)
-                            if u >= 0.0:
-                                guess = u * h
-                        root = locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y, k, tau, dt,
-                                           ax, ay, has_ay, sh, sv, yr, stages, ytmp, w7, gw)
-                    else:
-                        root = lo
-                    # a later-priority event wins only if it is clearly earlier
-                    if root < best_h - 2.0 * ROOT_TIME_TOL:
-                        best_h = root
-                        best_e = e
-            if best_e < 0:
-                # accept the whole step
-                peak_th, peak_th_time = rotation_peak(
-                    peak_th, peak_th_time, y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h,
-                    k * dt + tau, k * dt + (tau + h))
-                for i in range(N_STATE):
-                    y[i] = y1[i]
-                    stages[0, i] = f_end[i]  # first same as last: f(y) for the next step
-                fsal = True
-                for e in range(N_EVENTS):
-                    g0[e] = g1[e]
-                rearm(armed, g1)
-                summary[S_MODE_TIME + mode_number(ms) - 1] += h
-                tau += h
-                if h < remaining:
-                    grow = SAFETY * max(err, 1e-10) ** (-1.0 / (DP_ERROR_ORDER + 1))
-                    h_rock = h * min(MAX_FACTOR, max(MIN_FACTOR, grow))
+                                if gm < 0.0:
+                                    fired = True
+                                    hi = u * h
+                                    g_hi = gm
+                    if fired:
+                        if g_lo > 0.0:
+                            guess = -1.0
+                            if e == EV_IMPACT:
+                                # first guess: the root of the step's quintic interpolant of theta
+                                c0, c1, c2, c3, c4, c5 = quintic_hermite(
+                                    y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h)
+                                u = bracketed_root(c0, c1, c2, c3, c4, c5, lo / h, hi / h, False)
+                                if u >= 0.0:
+                                    guess = u * h
+                            root = locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y, k, tau, dt,
+                                               ax, ay, has_ay, sh, sv, yr, stages, ytmp, w7, gw)
+                        else:
+                            root = lo
+                        # a later-priority event wins only if it is clearly earlier
+                        if root < best_h - 2.0 * ROOT_TIME_TOL:
+                            best_h = root
+                            best_e = e
+                if best_e < 0:
+                    # accept the whole step
+                    peak_th, peak_th_time = rotation_peak(
+                        peak_th, peak_th_time, y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h,
+                        k * dt + tau, k * dt + (tau + h))
+                    for i in range(N_STATE):
+                        y[i] = y1[i]
+                        stages[0, i] = f_end[i]  # first same as last: f(y) for the next step
+                    fsal = True
+                    for e in range(N_EVENTS):
+                        g0[e] = g1[e]
+                    rearm(armed, g1)
+                    summary[S_MODE_TIME + mode_number(ms) - 1] += h
+                    tau += h
+                    if h < remaining:
+                        grow = SAFETY * max(err, 1e-10) ** (-1.0 / (DP_ERROR_ORDER + 1))
+                        h_rock = h * min(MAX_FACTOR, max(MIN_FACTOR, grow))
         if best_e >= 0:
-            # advance to the event (the closed-form span has done so already) and apply it
-            if ms[MS_ROCK]:
+            # advance to the event (the spans have done so already) and apply it
+            if ms[MS_ROCK] and not span_impact:
                 advance(p, ms, y, k, tau, best_h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp,
                         w7, fsal, rtol, atol)
                 for i in range(N_STATE):

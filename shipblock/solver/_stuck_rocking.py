@@ -41,7 +41,7 @@ from shipblock.solver._dopri import DP_A, DP_C, DP_E
 from shipblock.solver._events import event_functions, rearm
 from shipblock.solver._fused import fma
 from shipblock.solver._history import store_sample
-from shipblock.solver._interpolate import rotation_peak
+from shipblock.solver._interpolate import bracketed_root, quintic_hermite, rotation_peak
 from shipblock.solver._layout import (
     EV_IMPACT,
     MS_ROCK,
@@ -51,6 +51,7 @@ from shipblock.solver._layout import (
     N_DYN,
     N_EVENTS,
     N_STATE,
+    ROOT_TIME_TOL,
     Y_OM,
     Y_TH,
     Y_VB,
@@ -64,6 +65,9 @@ from shipblock.system import P_G, P_M, P_NM, P_R, P_THC
 #: Largest |delta| [rad] for the series of :func:`small_angle_sincos` (truncation below 1e-17
 #: relative); beyond it the stage takes its own sine and cosine.
 SMALL_ANGLE = 0.25
+
+#: Newton iterations allowed to :func:`locate_impact` (two or three are usual).
+IMPACT_NEWTON_ITERATIONS = 8
 
 # The tableau as scalars (numba freezes module floats into the machine code).
 A21 = float(DP_A[1, 0])
@@ -298,33 +302,139 @@ def stuck_forces_into(p, s, c, sn, om, al, a, ay, w7):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def stuck_rocking_span(p, ms, y, k, dt, ax, ay, has_ay, sh, sv, rtol, atol, armed, g0, g1,
+def locate_impact(p, gain, s, c, sn, th, om, w, al, pw, th1, om1, al1, a0, da, b0, db, f0, h, dt):
+    """Time to the impact inside an accepted mode-3 step: ``(ok, t, theta, omega, work, alpha)``.
+
+    The step of ``h`` from ``(th, om)`` ends past zero (``s th1 < 0``); it starts off zero
+    (``s th > 0``), or at zero from an impact just before (``th = 0``, ``s om > 0``), when the
+    root sought is the one after the turn of the rotation. The first guess is the root of the
+    step's quintic Hermite interpolant; Newton's iteration then runs on
+    the integrator's own solution, each trial a :func:`stuck_step` of length ``t`` from the same
+    start (no sine or cosine): :math:`\\delta = -\\theta(t)/\\dot\\theta(t)`. Once the next
+    Newton error, :math:`|\\ddot\\theta\\,\\delta^2 / (2\\dot\\theta)|`, is below
+    ``ROOT_TIME_TOL``, the state is carried to :math:`t + \\delta` by its Taylor series from the
+    trial (:math:`\\theta \\approx \\ddot\\theta\\delta^2/2`, :math:`\\dot\\theta + \\ddot\\theta\\delta`,
+    :math:`W + P\\delta`; the terms left out are of order :math:`\\delta^2` in the rates, below
+    rounding for the :math:`|\\delta| \\lesssim 10^{-9}` s a quintic guess leaves), so one trial
+    step usually suffices. ``ok`` is False (the kernel then locates the impact by bracketing)
+    if the rotation is not heading into zero at a trial or an iterate leaves the bracket.
+    """
+    c0, c1, c2, c3, c4, c5 = quintic_hermite(th, om, al, th1, om1, al1, h)
+    lo = 0.0
+    if th == 0.0:
+        # from the impact before: out and back within the step; the root is past the turn
+        lo = bracketed_root(c0, c1, c2, c3, c4, c5, 0.0, 1.0, True)
+        if not lo > 0.0:
+            return False, 0.0, 0.0, 0.0, 0.0, 0.0
+    u = bracketed_root(c0, c1, c2, c3, c4, c5, lo, 1.0, False)
+    if not u > lo:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0
+    t = u * h
+    t_lo = lo * h
+    for _ in range(IMPACT_NEWTON_ITERATIONS):
+        tht, omt, wt, alt, pwt, _c, _sn, _e, _eo = stuck_step(
+            p, gain, s, c, sn, th, om, w, al, pw, a0, da, b0, db, f0, t / dt, t)
+        if not s * omt < 0.0:
+            break
+        delta = -tht / omt
+        t_next = t + delta
+        if not t_lo < t_next <= h:
+            break
+        if abs(alt * delta * delta) <= 2.0 * ROOT_TIME_TOL * abs(omt):
+            return (True, t_next, 0.5 * alt * delta * delta, fma(alt, delta, omt),
+                    fma(pwt, delta, wt), alt)
+        t = t_next
+    return False, 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+#: Verdicts of :func:`checked_step`.
+STEP_ACCEPTED, STEP_REFUSED, STEP_TO_IMPACT = 0, 1, 2
+
+
+@njit(cache=True, inline="always")
+def checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0, fh, h, dt,
+                 rtol, atol, armed, g1):
+    """One mode-3 step of the span to the next sample, and what the span makes of it.
+
+    Returns the verdict, the step's end (state, rates, geometry, interface forces) and, for
+    ``STEP_TO_IMPACT``, the time and state (theta, omega, work, alpha) at the impact. The step is
+    ``STEP_ACCEPTED`` when the kernel would accept it with nothing to do: its error norm is at
+    most 1 and no watched event function ends below zero or, for the impact, may have dipped
+    below it inside the step (the rotation heading for zero at the start and away from it at the
+    end). A step that ends past an impact, with no other event and the impact located by
+    :func:`locate_impact`, is ``STEP_TO_IMPACT``. Otherwise ``STEP_REFUSED``: the kernel takes
+    the step. ``g1`` gets the event functions at the step's end; ``y[Y_TH]`` is left at the
+    step's end if it is accepted, else at its start.
+    """
+    th1, om1, w1, al1, pw1, c1, sn1, e_th, e_om = stuck_step(
+        p, gain, s, c, sn, th, om, w, al, pw, a0, a1 - a0, b0, b1 - b0, f0, fh, h)
+    verdict = STEP_REFUSED
+    t_imp = th_i = om_i = w_i = al_i = 0.0
+    fx1 = fy1 = Fx1 = Fy1 = 0.0
+    # the error norm of stuck_error_norm <= 1, without its divisions and square root (False
+    # too when the state is not finite)
+    sc_th = atol + rtol * max(abs(th), abs(th1))
+    sc_om = atol + rtol * max(abs(om), abs(om1))
+    if (e_th * sc_om) ** 2 + (e_om * sc_th) ** 2 <= N_DYN * (sc_th * sc_om) ** 2:
+        fx1, fy1, Fx1, Fy1 = stuck_rocking_forces(p, c1, sn1, s, om1, al1, a1, p[P_G] + b1)
+        y[Y_TH] = th1
+        event_functions(p, ms, y, fx1, fy1, Fx1, Fy1, g1)
+        # the usual case first, in as few operations as the kernel's own test
+        quiet = not (armed[EV_IMPACT] and s * th > 0.0 and s * om < 0.0 and s * om1 > 0.0)
+        for e in range(N_EVENTS):
+            if g1[e] < 0.0 and armed[e]:
+                quiet = False
+        if quiet:
+            verdict = STEP_ACCEPTED
+        else:
+            y[Y_TH] = th
+            impact_alone = armed[EV_IMPACT] and g1[EV_IMPACT] < 0.0 and (
+                s * th > 0.0 or th == 0.0 and s * om > 0.0)
+            for e in range(N_EVENTS):
+                if g1[e] < 0.0 and armed[e] and e != EV_IMPACT:
+                    impact_alone = False
+            if impact_alone:
+                ok, t_imp, th_i, om_i, w_i, al_i = locate_impact(
+                    p, gain, s, c, sn, th, om, w, al, pw, th1, om1, al1, a0, a1 - a0, b0, b1 - b0,
+                    f0, h, dt)
+                if ok:
+                    verdict = STEP_TO_IMPACT
+    return (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i, w_i,
+            al_i)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol, armed, g0, g1,
                        peak_th, peak_th_time, store, hist, modes, mode):
-    """Advance mode 3 by whole samples, one step each, until something may happen.
+    """Advance mode 3 to the next sample and on by whole samples, up to the next event.
 
     The rocking counterpart of :func:`~shipblock.solver._closed_form.nonrocking_span`: the
     kernel's steps, but with the state and the pivot geometry carried from step to step in
     registers (the geometry at a step's end is the angle-addition result of its last stage, so
-    no sine or cosine is taken per step). A step is accepted here only if the kernel would
-    accept it with nothing to do: its error norm is at most 1 and no watched event function
-    ends below zero or, for the impact, may have dipped below it inside the step (the rotation
-    heading for zero at the start and away from it at the end). Otherwise the span stops at the
-    step's start and the kernel takes that step itself, locating and applying the event.
+    no sine or cosine is taken per step). Each step is judged by :func:`checked_step`: accepted,
+    cut at an impact (the span then stops there, with the state just before the impact, for the
+    kernel to apply it), or refused (the span stops at the step's start and the kernel takes
+    that step itself, locating and applying the event). A span that starts inside a sample
+    (after an impact) first takes the rest of that sample, outside the loop of whole samples,
+    whose step length and input fractions are then constants of the loop.
 
     Parameters
     ----------
     p : tuple
         Parameters.
     ms, y : ndarray
-        Mode state (mode 3) and state at sample ``k`` (``y`` is updated in place).
+        Mode state (mode 3) and state at ``k * dt + tau`` (``y`` is updated in place).
     k : int
-        Current sample (the span starts on a sample).
+        Current sample.
+    tau : float
+        Time since sample ``k`` [s], 0 <= tau < dt.
     dt, ax, ay, has_ay, sh, sv, rtol, atol
         As in :func:`~shipblock.solver._kernel.run`.
     armed : ndarray of bool
         Events being watched; disarmed ones are re-armed once clear of zero.
     g0, g1 : ndarray, shape (N_EVENTS,)
-        The event functions at the start (updated to those at the span's end) and work.
+        The event functions at the start (updated to those where the span stopped, unless at
+        an impact) and work.
     peak_th, peak_th_time : float
         Running peak of |theta| and its time.
     store, hist, modes, mode
@@ -334,6 +444,12 @@ def stuck_rocking_span(p, ms, y, k, dt, ax, ay, has_ay, sh, sv, rtol, atol, arme
     -------
     k : int
         The sample where the span stopped.
+    tau : float
+        Time since that sample [s]: 0, unless the span stopped inside a sample (at an impact,
+        or before the rest of the sample it started in).
+    impact : bool
+        Whether the span stopped at an impact (``y`` just before it, theta within
+        ``ROOT_TIME_TOL`` of zero in time).
     time_in_mode : float
         Time advanced [s].
     peak_th, peak_th_time : float
@@ -350,30 +466,48 @@ def stuck_rocking_span(p, ms, y, k, dt, ax, ay, has_ay, sh, sv, rtol, atol, arme
     sn = math.sin(phi)
     a0 = sh * ax[k]
     b0 = sv * ay[k] if has_ay else 0.0
-    al, pw = stuck_rocking_rates(p, gain, c, sn, s, om, a0, b0)
     time_in_mode = 0.0
     all_armed = False  # until rearm() has looked
     forces_known = False
     fx = fy = Fx = Fy = 0.0
-    while k < n - 1:
+    verdict = STEP_ACCEPTED
+    t_imp = th_i = om_i = w_i = al_i = 0.0
+    if tau > 0.0:
+        # the rest of the sample the span starts in
+        f0 = tau / dt
         a1 = sh * ax[k + 1]
         b1 = sv * ay[k + 1] if has_ay else 0.0
-        th1, om1, w1, al1, pw1, c1, sn1, e_th, e_om = stuck_step(
-            p, gain, s, c, sn, th, om, w, al, pw, a0, a1 - a0, b0, b1 - b0, 0.0, 1.0, dt)
-        # the error norm of stuck_error_norm <= 1, without its divisions and square root
-        sc_th = atol + rtol * max(abs(th), abs(th1))
-        sc_om = atol + rtol * max(abs(om), abs(om1))
-        if not ((e_th * sc_om) ** 2 + (e_om * sc_th) ** 2 <= N_DYN * (sc_th * sc_om) ** 2):
-            break  # a smaller step is needed (or the state is not finite)
-        fx1, fy1, Fx1, Fy1 = stuck_rocking_forces(p, c1, sn1, s, om1, al1, a1, p[P_G] + b1)
-        y[Y_TH] = th1
-        event_functions(p, ms, y, fx1, fy1, Fx1, Fy1, g1)
-        quiet = not (armed[EV_IMPACT] and s * th > 0.0 and s * om < 0.0 and s * om1 > 0.0)
-        for e in range(N_EVENTS):
-            if g1[e] < 0.0 and armed[e]:
-                quiet = False
-        if not quiet:
+        al, pw = stuck_rocking_rates(p, gain, c, sn, s, om, a0 + (a1 - a0) * f0,
+                                     b0 + (b1 - b0) * f0)
+        h = dt - tau
+        (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i, w_i,
+         al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0,
+                              1.0 - f0, h, dt, rtol, atol, armed, g1)
+        if verdict == STEP_ACCEPTED:
+            all_armed = rearm(armed, g1)
+            t0 = k * dt + tau
+            peak_th, peak_th_time = rotation_peak(peak_th, peak_th_time, th, om, al, th1, om1,
+                                                  al1, h, t0, k * dt + dt)
+            time_in_mode += h
+            k += 1
+            tau = 0.0
+            th, om, w, al, pw, c, sn, a0, b0 = th1, om1, w1, al1, pw1, c1, sn1, a1, b1
+            fx, fy, Fx, Fy = fx1, fy1, Fx1, Fy1
+            forces_known = True
             y[Y_TH] = th
+            y[Y_OM] = om
+            y[Y_WIN] = w
+            if store:
+                store_sample(p, ms, y, hist, modes, k, mode)
+    else:
+        al, pw = stuck_rocking_rates(p, gain, c, sn, s, om, a0, b0)
+    while verdict == STEP_ACCEPTED and k < n - 1:
+        a1 = sh * ax[k + 1]
+        b1 = sv * ay[k + 1] if has_ay else 0.0
+        (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i, w_i,
+         al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, 0.0,
+                              1.0, dt, dt, rtol, atol, armed, g1)
+        if verdict != STEP_ACCEPTED:
             break
         if not all_armed:
             all_armed = rearm(armed, g1)
@@ -388,7 +522,17 @@ def stuck_rocking_span(p, ms, y, k, dt, ax, ay, has_ay, sh, sv, rtol, atol, arme
         y[Y_WIN] = w
         if store:
             store_sample(p, ms, y, hist, modes, k, mode)
+    if verdict == STEP_TO_IMPACT:
+        t0 = k * dt + tau
+        peak_th, peak_th_time = rotation_peak(peak_th, peak_th_time, th, om, al, th_i, om_i, al_i,
+                                              t_imp, t0, t0 + t_imp)
+        y[Y_TH] = th_i
+        y[Y_OM] = om_i
+        y[Y_WIN] = w_i
+        tau += t_imp
+        time_in_mode += t_imp
+        return k, tau, True, time_in_mode, peak_th, peak_th_time
     if forces_known:
         # the event functions where the span stopped, for the kernel's next step
         event_functions(p, ms, y, fx, fy, Fx, Fy, g0)
-    return k, time_in_mode, peak_th, peak_th_time
+    return k, tau, False, time_in_mode, peak_th, peak_th_time
