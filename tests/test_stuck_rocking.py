@@ -44,6 +44,7 @@ from shipblock.solver._stuck_rocking import (
     SHORT_ANGLE,
     SMALL_ANGLE,
     locate_impact,
+    rotating_step,
     short_angle_sincos,
     small_angle_sincos,
     stuck_step,
@@ -277,3 +278,42 @@ def test_impact_is_located_at_the_integrators_own_root(from_zero):
         assert s * om_i < 0.0  # arriving at the impact
         checked += 1
     assert checked > 40
+
+
+def test_rotating_step_agrees_with_the_angle_form():
+    """The whole-sample step with the geometry as states is the same method to truncation error.
+
+    From random mode-3 states, one step of rotating_step and of stuck_step (angle form): the
+    same rotation, angular velocity and input work within the step's own error estimate, and a
+    geometry that stays on the unit circle and equals cos/sin(theta_c - s theta) at the step's
+    end within that estimate too (the angle form's geometry is exact for its theta, whose own
+    truncation error is of that size). A sign error in either geometry rate would put the
+    geometry off by the step's rotation (~1e-3), far outside these bounds.
+    """
+    rng = np.random.default_rng(17)
+    for _ in range(300):
+        system = _random_system(rng)
+        p = parameter_tuple(system.to_parameter_vector())
+        s = float(rng.choice([-1.0, 1.0]))
+        dt = float(rng.choice([0.005, 0.01, 0.02]))
+        gain = stuck_rocking_gain(p)
+        th0 = s * rng.uniform(0.05, 0.9) * p[P_THC]
+        om0 = rng.uniform(-3.0, 3.0)
+        a0, a1, b0, b1 = rng.uniform(-5.0, 5.0, 4)
+        phi = p[P_THC] - s * th0
+        c, sn = math.cos(phi), math.sin(phi)
+        al, pw = stuck_rocking_rates(p, gain, c, sn, s, om0, a0, b0)
+        ref = stuck_step(p, gain, s, c, sn, th0, om0, 10.0, al, pw, a0, a1 - a0, b0, b1 - b0, 0.0,
+                         1.0, dt)
+        new = rotating_step(p, gain, s, c, sn, th0, om0, 10.0, al, pw, a0, a1 - a0, b0, b1 - b0,
+                            dt)
+        th1, om1, w1, _, _, u1, v1, e_th, e_om = new
+        # both are 5th-order solutions: they differ by less than the 4th-order error estimate
+        assert abs(th1 - ref[0]) <= abs(e_th) + abs(ref[7]) + 1e-15
+        assert abs(om1 - ref[1]) <= abs(e_om) + abs(ref[8]) + 1e-14 * abs(om0)
+        assert abs(w1 - ref[2]) <= 1e-6 * (abs(w1 - 10.0) + 1e-9)
+        # the geometry leaves the circle, and the angle, by the step's truncation error only
+        bound = abs(e_th) + dt * abs(e_om) + 1e-15
+        phi1 = p[P_THC] - s * th1
+        assert abs(u1 * u1 + v1 * v1 - 1.0) <= bound
+        assert abs(u1 - math.cos(phi1)) <= bound and abs(v1 - math.sin(phi1)) <= bound
