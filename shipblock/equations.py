@@ -71,9 +71,10 @@ SINGULAR_RELATIVE = 1e-12
 def pivot_geometry(p, theta, s, rock):
     """Return ``(c, sn)`` = (cos phi, sin phi) with phi = theta_c - s*theta.
 
-    At rest the geometry is that of theta = 0: ``R c = H`` and ``R sn = B``.
+    At rest, or rocking at theta = 0 (just after an impact), the geometry is ``R c = H`` and
+    ``R sn = B`` (no cosine and sine to take).
     """
-    if rock:
+    if rock and theta != 0.0:
         phi = p[P_THC] - s * theta
         return math.cos(phi), math.sin(phi)
     return p[P_H] / p[P_R], p[P_B] / p[P_R]

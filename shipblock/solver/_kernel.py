@@ -35,6 +35,8 @@ from shipblock.equations import (
     potential_energy,
     solve_mode,
     solve_mode_at,
+    stuck_rocking_gain,
+    stuck_rocking_rates,
 )
 from shipblock.impact import apply_impact
 from shipblock.modes import MODE_NUMBER, EventKind, Failure
@@ -114,7 +116,12 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     Y_XS,
     parameter_tuple,
 )
-from shipblock.solver._stuck_rocking import advance_stuck, is_stuck_rocking, stuck_rocking_span
+from shipblock.solver._stuck_rocking import (
+    advance_stuck,
+    is_stuck_rocking,
+    stuck_forces_into,
+    stuck_rocking_span,
+)
 from shipblock.solver._workqueue import claim_next
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
@@ -503,12 +510,16 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
             for i in range(N_SOLVE_OUT):
                 w7[i] = work[start + i] * a + work[start + N_SOLVE_OUT + i] * G
         else:
+            c, sn = pivot_geometry(p, th, float(s), rock)
+            if slip1 == 0 and slip2 == 0:
+                # mode 3 (both interfaces held, so no slip velocities): its reduced form, the
+                # general equations to rounding (tests/test_stuck_rocking.py), after every impact
+                al, _ = stuck_rocking_rates(p, stuck_rocking_gain(p), c, sn, float(s), om, a, b)
+                stuck_forces_into(p, float(s), c, sn, om, al, a, b, w7)
             # solve_mode without its wrapper's call: this runs for one to three candidates per
             # event
-            c, sn = pivot_geometry(p, th, float(s), rock)
-            ok = solve_mode_at(p, slip1, rock, slip2, float(s), float(sig1), float(sig2), c, sn,
-                               om, a, G, w7)
-            if not ok:
+            elif not solve_mode_at(p, slip1, rock, slip2, float(s), float(sig1), float(sig2), c,
+                                   sn, om, a, G, w7):
                 continue
         fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
         viol = 0.0
@@ -671,6 +682,7 @@ summary, y_init
         store_sample(p, ms, y, hist, modes, 0, 0 if failure else mode_number(ms))
     h_rock = dt
     events_here = 0
+    g0_stale = False
     while k < n - 1 and failure == 0:
         if ms[MS_ROCK] == 0:
             # rest and sliding: closed form, sample by sample, up to the next event
@@ -701,6 +713,7 @@ summary, y_init
                 if span_time > 0.0:
                     summary[S_MODE_TIME + mode_number(ms) - 1] += span_time
                     fsal = False
+                    g0_stale = span_impact  # the span left them where it stopped
                 if k != k_before:
                     events_here = 0
                 if k >= n - 1:
@@ -711,6 +724,9 @@ summary, y_init
             if not span_impact:
                 # rocking: error-controlled Dormand-Prince steps within the sample interval, where
                 # the input is linear (a step across a sample would straddle a kink of the input)
+                if g0_stale:
+                    event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g0, w7)
+                    g0_stale = False
                 remaining = dt - tau
                 h = min(h_rock, remaining)
                 err = advance(p, ms, y, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
@@ -890,9 +906,10 @@ summary, y_init
             if events_here > MAX_EVENTS_PER_SAMPLE and failure == 0:
                 failure = Failure.SOLVER_ERROR
                 failure_time = t_now
-            if failure == 0 and ms[MS_ROCK]:
-                # the rocking steps compare with these; the closed-form span finds its own
-                event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g0, w7)
+            # the rocking steps compare with the event functions here: evaluated before the
+            # kernel's next step, unless a span has left its own (the closed-form span finds
+            # its own)
+            g0_stale = failure == 0 and ms[MS_ROCK] != 0
         # peaks
         axb = abs(y[Y_XB])
         if axb > peak_xb:

@@ -37,6 +37,7 @@ from shipblock.equations import (
     I_TH_DD,
     I_XB_DD,
     I_XS_DD,
+    pivot_geometry,
     stuck_rocking_forces,
     stuck_rocking_gain,
     stuck_rocking_rates,
@@ -64,7 +65,7 @@ from shipblock.solver._layout import (
     Y_XB,
     Y_XS,
 )
-from shipblock.system import P_G, P_M, P_NM, P_R, P_THC
+from shipblock.system import P_G, P_M, P_NM, P_R
 
 #: Largest |delta| [rad] for the series of :func:`small_angle_sincos` (truncation below 1e-17
 #: relative); beyond it the stage takes its own sine and cosine.
@@ -341,9 +342,7 @@ def advance_stuck(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, 
     db = (sv * ay[k + 1] if has_ay else 0.0) - b0
     th0 = y0[Y_TH]
     om0 = y0[Y_OM]
-    phi0 = p[P_THC] - s * th0
-    c0 = math.cos(phi0)
-    s0 = math.sin(phi0)
+    c0, s0 = pivot_geometry(p, th0, s, 1)
     f0 = tau / dt
     if first_stage_known:
         al1 = stages[0, Y_OM]
@@ -553,9 +552,7 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
     th = y[Y_TH]
     om = y[Y_OM]
     w = y[Y_WIN]
-    phi = p[P_THC] - s * th
-    c = math.cos(phi)
-    sn = math.sin(phi)
+    c, sn = pivot_geometry(p, th, s, 1)
     a0 = sh * ax[k]
     b0 = sv * ay[k] if has_ay else 0.0
     time_in_mode = 0.0
