@@ -74,6 +74,10 @@ SMALL_ANGLE = 0.25
 #: Newton iterations allowed to :func:`locate_impact` (two or three are usual).
 IMPACT_NEWTON_ITERATIONS = 8
 
+#: Longest Taylor step [s] that finishes :func:`locate_impact` from a trial: the terms it
+#: leaves out (of order delta^2 in the rates) are then below rounding.
+IMPACT_TAYLOR_STEP = 1e-9
+
 # The tableau as scalars (numba freezes module floats into the machine code).
 A21 = float(DP_A[1, 0])
 A31, A32 = float(DP_A[2, 0]), float(DP_A[2, 1])
@@ -399,12 +403,13 @@ def locate_impact(p, gain, s, c, sn, th, om, w, al, pw, th1, om1, al1, a0, da, b
     the integrator's own solution, each trial a :func:`stuck_step` of length ``t`` from the same
     start (no sine or cosine): :math:`\\delta = -\\theta(t)/\\dot\\theta(t)`. Once the next
     Newton error, :math:`|\\ddot\\theta\\,\\delta^2 / (2\\dot\\theta)|`, is below
-    ``ROOT_TIME_TOL``, the state is carried to :math:`t + \\delta` by its Taylor series from the
-    trial (:math:`\\theta \\approx \\ddot\\theta\\delta^2/2`, :math:`\\dot\\theta + \\ddot\\theta\\delta`,
-    :math:`W + P\\delta`; the terms left out are of order :math:`\\delta^2` in the rates, below
-    rounding for the :math:`|\\delta| \\lesssim 10^{-9}` s a quintic guess leaves), so one trial
-    step usually suffices. ``ok`` is False (the kernel then locates the impact by bracketing)
-    if the rotation is not heading into zero at a trial or an iterate leaves the bracket.
+    ``ROOT_TIME_TOL`` and :math:`|\\delta|` at most ``IMPACT_TAYLOR_STEP``, the state is carried
+    to :math:`t + \\delta` by its Taylor series from the trial
+    (:math:`\\theta \\approx \\ddot\\theta\\delta^2/2`, :math:`\\dot\\theta + \\ddot\\theta\\delta`,
+    :math:`W + P\\delta`; the terms left out, of order :math:`\\delta^2` in the rates, are then
+    below rounding), so one trial step usually suffices after the quintic's guess. ``ok`` is
+    False (the kernel then locates the impact by bracketing) if the rotation is not heading
+    into zero at a trial or an iterate leaves the bracket.
     """
     c0, c1, c2, c3, c4, c5 = quintic_hermite(th, om, al, th1, om1, al1, h)
     lo = 0.0
@@ -427,7 +432,8 @@ def locate_impact(p, gain, s, c, sn, th, om, w, al, pw, th1, om1, al1, a0, da, b
         t_next = t + delta
         if not t_lo < t_next <= h:
             break
-        if abs(alt * delta * delta) <= 2.0 * ROOT_TIME_TOL * abs(omt):
+        if abs(delta) <= IMPACT_TAYLOR_STEP and (
+                abs(alt * delta * delta) <= 2.0 * ROOT_TIME_TOL * abs(omt)):
             return (True, t_next, 0.5 * alt * delta * delta, fma(alt, delta, omt),
                     fma(pwt, delta, wt), alt)
         t = t_next
