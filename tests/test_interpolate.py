@@ -10,7 +10,14 @@ import pytest
 import sympy as sp
 
 from shipblock.solver._closed_form import linear_root, min_linear_root, quadratic_root
-from shipblock.solver._interpolate import bracketed_root, poly5, poly5_slope, quintic_hermite
+from shipblock.solver._interpolate import (
+    bracketed_root,
+    poly5,
+    poly5_slope,
+    quintic_and_slope,
+    quintic_hermite,
+    rotation_peak,
+)
 
 
 def test_quintic_hermite_matches_symbolic_interpolation_conditions():
@@ -58,6 +65,68 @@ def test_bracketed_root_of_value_and_of_slope():
     assert bracketed_root(*c, 0.0, 1.0, True) == pytest.approx(crit[0], abs=1e-13)
     # no sign change: no root
     assert bracketed_root(*c, 0.0, 1.0, False) == -1.0
+
+
+def test_quintic_and_slope_agrees_with_separate_horner():
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        c = tuple(rng.normal(size=6))
+        u = rng.uniform(-0.5, 1.5)
+        q, d = quintic_and_slope(*c, u)
+        assert q == pytest.approx(poly5(*c, u), rel=1e-13, abs=1e-14)
+        assert d == pytest.approx(poly5_slope(*c[1:], u), rel=1e-13, abs=1e-14)
+
+
+def test_bracketed_root_when_the_last_newton_step_is_below_float_spacing():
+    """A near-linear quintic whose last Newton correction is smaller than the spacing of floats
+    at the root (a rocking step through an impact): the root to rounding, from either side."""
+    c = (1.44858649e-03, -3.51880060e-03, -1.53347102e-05, 4.09628242e-06, -1.11469536e-17,
+         1.41454502e-18)
+    u = sp.symbols("u")
+    roots = sp.Poly(sum(sp.Float(ci, 30) * u**i for i, ci in enumerate(c)), u).nroots(n=30)
+    exact = [float(sp.re(r)) for r in roots if abs(sp.im(r)) < 1e-20 and 0 < sp.re(r) < 1]
+    assert len(exact) == 1
+    for lo, hi in ((0.0, 1.0), (0.2, 0.9), (0.4, 0.5)):
+        assert bracketed_root(*c, lo, hi, False) == pytest.approx(exact[0], abs=1e-15)
+
+
+def test_rotation_peak_finds_every_extremum_above_the_running_peak():
+    """The bound that lets rotation_peak skip an extremum never skips one above the running
+    peak: against the interpolant sampled densely, with running peaks just below and just
+    above each step's extremum."""
+    rng = np.random.default_rng(21)
+    h = 0.005
+    uu = np.linspace(0.0, 1.0, 20001)
+    tested = 0
+    for _ in range(300):
+        # theta_dot changes sign inside the step: omega = om0 + al * t + j t^2 / 2
+        th0 = rng.normal() * 0.05
+        al0 = rng.normal() * 10.0
+        jerk = rng.normal() * 300.0
+        t_turn = rng.uniform(0.05, 0.95) * h
+        om0 = -(al0 * t_turn + 0.5 * jerk * t_turn**2)
+        om1 = om0 + al0 * h + 0.5 * jerk * h * h
+        if om0 * om1 >= 0.0:
+            continue
+        th1 = th0 + om0 * h + al0 * h * h / 2 + jerk * h**3 / 6
+        al1 = al0 + jerk * h
+        c = quintic_hermite(th0, om0, al0, th1, om1, al1, h)
+        dense = np.abs(np.polynomial.Polynomial(c)(uu))
+        if dense.argmax() == 0:
+            continue  # the largest |theta| at the start: counted with the step before
+        ext = dense.max()
+        t0 = 1.0
+        for factor in (1.0 - 1e-7, 1.0 + 1e-7):
+            running = ext * factor
+            peak, when = rotation_peak(running, -1.0, th0, om0, al0, th1, om1, al1, h, t0, t0 + h)
+            if factor < 1.0:
+                # an extremum (or the end) above the running peak is found, at its time
+                assert peak == pytest.approx(ext, rel=1e-9, abs=1e-15)
+                assert abs(when - (t0 + uu[dense.argmax()] * h)) <= 2.0 * h / 20000
+            else:
+                assert (peak, when) == (running, -1.0)
+        tested += 1
+    assert tested > 100
 
 
 def _first_crossing(f, h, velocity=False, n=200001):

@@ -28,6 +28,8 @@ import math
 
 from numba import njit
 
+from shipblock.solver._fused import fma
+
 
 @njit(cache=True)
 def quintic_hermite(th0, om0, al0, th1, om1, al1, h):
@@ -58,19 +60,39 @@ def poly5_curvature(c2, c3, c4, c5, u):
     return 2.0 * c2 + u * (6.0 * c3 + u * (12.0 * c4 + u * 20.0 * c5))
 
 
+@njit(cache=True, inline="always")
+def quintic_and_slope(c0, c1, c2, c3, c4, c5, u):
+    """Value and derivative of the quintic at ``u``: one Horner pass, fused (two short chains)."""
+    d = c5
+    q = fma(c5, u, c4)
+    d = fma(d, u, q)
+    q = fma(q, u, c3)
+    d = fma(d, u, q)
+    q = fma(q, u, c2)
+    d = fma(d, u, q)
+    q = fma(q, u, c1)
+    d = fma(d, u, q)
+    q = fma(q, u, c0)
+    return q, d
+
+
 @njit(cache=True)
 def bracketed_root(c0, c1, c2, c3, c4, c5, lo, hi, derivative):
     """Root in ``[lo, hi]`` of the quintic (or of its derivative) that changes sign there.
 
     Safeguarded Newton: a Newton step that leaves the bracket is replaced by bisection, so it
     converges for any sign-changing bracket. Returns -1 when the ends have the same sign.
+    The derivative is the quartic of coefficients ``(c1, 2 c2, 3 c3, 4 c4, 5 c5)``; either
+    polynomial is evaluated with its slope in one fused Horner pass
+    (:func:`quintic_and_slope`), whose chain of dependent operations is what an iteration
+    costs.
     """
     if derivative:
-        f_lo = poly5_slope(c1, c2, c3, c4, c5, lo)
-        f_hi = poly5_slope(c1, c2, c3, c4, c5, hi)
+        b0, b1, b2, b3, b4, b5 = c1, 2.0 * c2, 3.0 * c3, 4.0 * c4, 5.0 * c5, 0.0
     else:
-        f_lo = poly5(c0, c1, c2, c3, c4, c5, lo)
-        f_hi = poly5(c0, c1, c2, c3, c4, c5, hi)
+        b0, b1, b2, b3, b4, b5 = c0, c1, c2, c3, c4, c5
+    f_lo, _ = quintic_and_slope(b0, b1, b2, b3, b4, b5, lo)
+    f_hi, _ = quintic_and_slope(b0, b1, b2, b3, b4, b5, hi)
     if f_lo == 0.0:
         return lo
     if f_hi == 0.0:
@@ -80,12 +102,7 @@ def bracketed_root(c0, c1, c2, c3, c4, c5, lo, hi, derivative):
     rising = f_hi > 0.0
     u = lo - f_lo * (hi - lo) / (f_hi - f_lo)
     for _ in range(60):
-        if derivative:
-            f = poly5_slope(c1, c2, c3, c4, c5, u)
-            df = poly5_curvature(c2, c3, c4, c5, u)
-        else:
-            f = poly5(c0, c1, c2, c3, c4, c5, u)
-            df = poly5_slope(c1, c2, c3, c4, c5, u)
+        f, df = quintic_and_slope(b0, b1, b2, b3, b4, b5, u)
         if f == 0.0:
             return u
         if (f > 0.0) == rising:
@@ -93,10 +110,15 @@ def bracketed_root(c0, c1, c2, c3, c4, c5, lo, hi, derivative):
         else:
             lo = u
         step = f / df if df != 0.0 else math.inf
+        # converged: tested before the safeguard, since a step below the spacing of floats
+        # lands on the end of the bracket just moved to u and would be taken for one leaving it
+        if abs(step) <= 1e-15 * max(1.0, abs(u)):
+            un = u - step
+            return un if lo <= un <= hi else u
         un = u - step
         if not (lo < un < hi):
             un = 0.5 * (lo + hi)
-        if abs(un - u) <= 1e-15 * max(1.0, abs(u)) or hi - lo <= 1e-15:
+        if hi - lo <= 1e-15:
             return un
         u = un
     return u
@@ -152,10 +174,21 @@ def rotation_extremum(th0, om0, al0, th1, om1, al1, h):
         Its time after the start of the step [s].
     """
     c0, c1, c2, c3, c4, c5 = quintic_hermite(th0, om0, al0, th1, om1, al1, h)
+    return quintic_extremum(c0, c1, c2, c3, c4, c5, th0, th1, h)
+
+
+@njit(cache=True)
+def quintic_extremum(c0, c1, c2, c3, c4, c5, th0, th1, h):
+    """:func:`rotation_extremum` from the step's interpolant ``(c0, ..., c5)``."""
     u = bracketed_root(c0, c1, c2, c3, c4, c5, 0.0, 1.0, True)
     if u < 0.0:
         return max(abs(th0), abs(th1)), 0.0
     return abs(poly5(c0, c1, c2, c3, c4, c5, u)), u * h
+
+
+#: Relative margin on the bound of :func:`rotation_peak` (far above the rounding of the
+#: interpolant's evaluation, so a skipped extremum can never have been the larger).
+PEAK_BOUND_MARGIN = 1e-9
 
 
 @njit(cache=True, inline="always")
@@ -163,13 +196,19 @@ def rotation_peak(peak, peak_time, th0, om0, al0, th1, om1, al1, h, t0, t1):
     """The running peak of |theta| and its time, updated with an accepted rocking step.
 
     The step runs from ``t0`` to ``t1 = t0 + h`` (both given, so that callers keep their own
-    arithmetic for times); an extremum inside it is read off :func:`rotation_extremum`.
+    arithmetic for times); an extremum inside it is read off :func:`rotation_extremum`, unless
+    it cannot exceed the running peak: on the step, :math:`|\\theta| \\le \\sum_k |c_k|` for
+    the interpolant's coefficients (:math:`0 \\le u \\le 1`), a bound that a rocking cycle
+    below the largest so far is well under, so its extremum is not sought.
     """
     if om0 * om1 < 0.0:
-        ext, s_ext = rotation_extremum(th0, om0, al0, th1, om1, al1, h)
-        if ext > peak:
-            peak = ext
-            peak_time = t0 + s_ext
+        c0, c1, c2, c3, c4, c5 = quintic_hermite(th0, om0, al0, th1, om1, al1, h)
+        bound = abs(c0) + abs(c1) + abs(c2) + abs(c3) + abs(c4) + abs(c5)
+        if bound * (1.0 + PEAK_BOUND_MARGIN) >= peak:
+            ext, s_ext = quintic_extremum(c0, c1, c2, c3, c4, c5, th0, th1, h)
+            if ext > peak:
+                peak = ext
+                peak_time = t0 + s_ext
     if abs(th1) > peak:
         peak = abs(th1)
         peak_time = t1

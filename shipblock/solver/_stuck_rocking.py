@@ -65,7 +65,7 @@ from shipblock.solver._layout import (
     Y_XB,
     Y_XS,
 )
-from shipblock.system import P_G, P_M, P_NM, P_R
+from shipblock.system import P_G, P_M, P_MUS1, P_MUS2, P_NM, P_R, P_THC
 
 #: Largest |delta| [rad] for the series of :func:`small_angle_sincos` (truncation below 1e-17
 #: relative); beyond it the stage takes its own sine and cosine.
@@ -446,7 +446,7 @@ STEP_ACCEPTED, STEP_REFUSED, STEP_TO_IMPACT = 0, 1, 2
 
 @njit(cache=True, inline="always")
 def checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0, fh, h, dt,
-                 rtol, atol, armed, g1, whole):
+                 rtol, atol, armed, g1, need_g, whole):
     """One mode-3 step of the span to the next sample, and what the span makes of it.
 
     Returns the verdict, the step's end (state, rates, geometry, interface forces) and, for
@@ -456,8 +456,9 @@ def checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0
     below it inside the step (the rotation heading for zero at the start and away from it at the
     end). A step that ends past an impact, with no other event and the impact located by
     :func:`locate_impact`, is ``STEP_TO_IMPACT``. Otherwise ``STEP_REFUSED``: the kernel takes
-    the step. ``g1`` gets the event functions at the step's end; ``y[Y_TH]`` is left at the
-    step's end if it is accepted, else at its start.
+    the step. ``g1`` gets the event functions at the step's end unless the step is accepted and
+    ``need_g`` is False; ``y[Y_TH]`` is left at the step's end if it is accepted, else at its
+    start.
     """
     if whole:
         th1, om1, w1, al1, pw1, c1, sn1, e_th, e_om = rotating_step(
@@ -475,12 +476,20 @@ def checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0
     if (e_th * sc_om) ** 2 + (e_om * sc_th) ** 2 <= N_DYN * (sc_th * sc_om) ** 2:
         fx1, fy1, Fx1, Fy1 = stuck_rocking_forces(p, c1, sn1, s, om1, al1, a1, p[P_G] + b1)
         y[Y_TH] = th1
-        event_functions(p, ms, y, fx1, fy1, Fx1, Fy1, g1)
-        # the usual case first, in as few operations as the kernel's own test
-        quiet = not (armed[EV_IMPACT] and s * th > 0.0 and s * om < 0.0 and s * om1 > 0.0)
-        for e in range(N_EVENTS):
-            if g1[e] < 0.0 and armed[e]:
-                quiet = False
+        # the usual case first: every event function of mode 3 clear of zero, read off the
+        # signs of their numerators (event_functions divides them by positive weights), and
+        # the rotation not dipping through zero inside the step
+        clear = (p[P_MUS1] * fy1 - abs(fx1) >= 0.0 and p[P_MUS2] * Fy1 - abs(Fx1) >= 0.0
+                 and fy1 >= 0.0 and Fy1 >= 0.0 and s * th1 >= 0.0 and p[P_THC] - s * th1 >= 0.0)
+        quiet = clear and not (armed[EV_IMPACT] and s * th > 0.0 and s * om < 0.0
+                               and s * om1 > 0.0)
+        if need_g or not clear:
+            event_functions(p, ms, y, fx1, fy1, Fx1, Fy1, g1)
+        if not clear:
+            quiet = not (armed[EV_IMPACT] and s * th > 0.0 and s * om < 0.0 and s * om1 > 0.0)
+            for e in range(N_EVENTS):
+                if g1[e] < 0.0 and armed[e]:
+                    quiet = False
         if quiet:
             verdict = STEP_ACCEPTED
         else:
@@ -577,7 +586,7 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
         h = dt - tau
         (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i, w_i,
          al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0,
-                              1.0 - f0, h, dt, rtol, atol, armed, g1, False)
+                              1.0 - f0, h, dt, rtol, atol, armed, g1, True, False)
         if verdict == STEP_ACCEPTED:
             all_armed = rearm(armed, g1)
             t0 = k * dt + tau
@@ -601,7 +610,7 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
         b1 = sv * ay[k + 1] if has_ay else 0.0
         (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i, w_i,
          al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, 0.0,
-                              1.0, dt, dt, rtol, atol, armed, g1, True)
+                              1.0, dt, dt, rtol, atol, armed, g1, not all_armed, True)
         if verdict != STEP_ACCEPTED:
             break
         if not all_armed:
