@@ -436,6 +436,29 @@ def test_peak_rotation_and_its_time_from_energy(ship_mass, n):
     assert abs(res.theta).max() < theta_max  # the samples miss the peak itself
 
 
+@pytest.mark.parametrize("ship_mass,n", [(1e-6, 1), (2e4, 4)])
+def test_peak_rotation_at_default_tolerance_and_mid_swing(ship_mass, n):
+    """The same launch at the default tolerance (whole-sample steps of the mode-3 span, which
+    updates the running peak only where theta_dot turns and where it stops): the located
+    extremum; and on a record that ends while the block is still rising, the peak is the last
+    sample, at its time."""
+    system = rocking_system(ship_mass=ship_mass, n=n)
+    alpha = system.critical_angle
+    J, W = rocking_constants(system)
+    w0 = 0.35
+    theta_max = alpha - math.acos(math.cos(alpha) + J * w0**2 / (2 * W))
+    t_peak = quarter_time(theta_max, alpha, J, W)
+    launch = (0, 0, 0, 0, w0, 0)
+    res = simulate(system, np.zeros(200), None, 0.01, initial_state=launch)
+    assert res.summary["peak_rotation"] == pytest.approx(theta_max, rel=1e-7)
+    assert res.summary["peak_rotation_time"] == pytest.approx(t_peak, abs=1e-6)
+    n_rising = int(t_peak / 0.01) - 2
+    short = simulate(system, np.zeros(n_rising), None, 0.01, initial_state=launch)
+    assert np.all(np.diff(short.theta) > 0.0)
+    assert short.summary["peak_rotation"] == abs(short.theta[-1])
+    assert short.summary["peak_rotation_time"] == pytest.approx(short.time[-1], abs=1e-12)
+
+
 def test_parameter_tuple_carries_the_whole_parameter_vector():
     """The kernels index the parameters as a tuple; it must hold every entry of the vector."""
     from shipblock.solver._layout import parameter_tuple

@@ -615,8 +615,12 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
             break
         if not all_armed:
             all_armed = rearm(armed, g1)
-        peak_th, peak_th_time = rotation_peak(peak_th, peak_th_time, th, om, al, th1, om1, al1,
-                                              dt, k * dt, k * dt + dt)
+        if om * om1 <= 0.0:
+            # between turns of theta_dot, |theta| is monotone (theta cannot cross zero inside
+            # an accepted step): the running peak can only grow at a turn, or where the span
+            # stops (below)
+            peak_th, peak_th_time = rotation_peak(peak_th, peak_th_time, th, om, al, th1, om1,
+                                                  al1, dt, k * dt, k * dt + dt)
         time_in_mode += dt
         k += 1
         th, om, w, al, pw, c, sn, a0, b0 = th1, om1, w1, al1, pw1, c1, sn1, a1, b1
@@ -626,6 +630,10 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
         y[Y_WIN] = w
         if store:
             store_sample(p, ms, y, hist, modes, k, mode)
+    if abs(th) > peak_th:
+        # the end of the last step accepted (as rotation_peak would have timed it)
+        peak_th = abs(th)
+        peak_th_time = (k - 1) * dt + dt if time_in_mode > 0.0 else k * dt + tau
     if verdict == STEP_TO_IMPACT:
         t0 = k * dt + tau
         peak_th, peak_th_time = rotation_peak(peak_th, peak_th_time, th, om, al, th_i, om_i, al_i,
