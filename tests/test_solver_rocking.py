@@ -418,6 +418,16 @@ def test_missing_vertical_equals_zero_vertical():
     for key, values in without.items():
         np.testing.assert_array_equal(values, with_zero[key], err_msg=key)
 
+def _launched_peak(system, w0):
+    """Peak rotation and its time of free rocking launched from theta = 0 with theta_dot = w0:
+    J w0^2 / 2 = W (cos(alpha - theta_max) - cos(alpha)), reached after the quarter time of
+    free rocking from theta_max."""
+    alpha = system.critical_angle
+    J, W = rocking_constants(system)
+    theta_max = alpha - math.acos(math.cos(alpha) + J * w0**2 / (2 * W))
+    return theta_max, quarter_time(theta_max, alpha, J, W)
+
+
 @pytest.mark.parametrize("ship_mass,n", [(1e-6, 1), (2e4, 4)])
 def test_peak_rotation_and_its_time_from_energy(ship_mass, n):
     """Launched from theta = 0 with theta_dot = w0 and no ground motion, the block rises to
@@ -425,11 +435,8 @@ def test_peak_rotation_and_its_time_from_energy(ship_mass, n):
     quarter time of free rocking from theta_max. The peak falls inside a solver step, so this
     checks the located extremum (value and time), not the nearest sample."""
     system = rocking_system(ship_mass=ship_mass, n=n)
-    alpha = system.critical_angle
-    J, W = rocking_constants(system)
     w0 = 0.35
-    theta_max = alpha - math.acos(math.cos(alpha) + J * w0**2 / (2 * W))
-    t_peak = quarter_time(theta_max, alpha, J, W)
+    theta_max, t_peak = _launched_peak(system, w0)
     res = simulate(system, np.zeros(200), None, 0.01, initial_state=(0, 0, 0, 0, w0, 0), **TIGHT)
     assert res.summary["peak_rotation"] == pytest.approx(theta_max, rel=1e-9)
     assert res.summary["peak_rotation_time"] == pytest.approx(t_peak, abs=1e-8)
@@ -443,11 +450,8 @@ def test_peak_rotation_at_default_tolerance_and_mid_swing(ship_mass, n):
     extremum; and on a record that ends while the block is still rising, the peak is the last
     sample, at its time."""
     system = rocking_system(ship_mass=ship_mass, n=n)
-    alpha = system.critical_angle
-    J, W = rocking_constants(system)
     w0 = 0.35
-    theta_max = alpha - math.acos(math.cos(alpha) + J * w0**2 / (2 * W))
-    t_peak = quarter_time(theta_max, alpha, J, W)
+    theta_max, t_peak = _launched_peak(system, w0)
     launch = (0, 0, 0, 0, w0, 0)
     res = simulate(system, np.zeros(200), None, 0.01, initial_state=launch)
     assert res.summary["peak_rotation"] == pytest.approx(theta_max, rel=1e-7)

@@ -27,6 +27,7 @@ from shipblock.equations import (
     stuck_rocking_gain,
     stuck_rocking_rates,
 )
+from shipblock.solver._events import event_functions, stuck_rocking_clear
 from shipblock.solver._fused import fma
 from shipblock.solver._kernel import advance, advance_general, error_norm
 from shipblock.solver._layout import (
@@ -34,6 +35,7 @@ from shipblock.solver._layout import (
     MS_S,
     MS_SIG1,
     MS_SIG2,
+    N_EVENTS,
     N_STATE,
     Y_OM,
     Y_TH,
@@ -317,3 +319,38 @@ def test_rotating_step_agrees_with_the_angle_form():
         phi1 = p[P_THC] - s * th1
         assert abs(u1 * u1 + v1 * v1 - 1.0) <= bound
         assert abs(u1 - math.cos(phi1)) <= bound and abs(v1 - math.sin(phi1)) <= bound
+
+
+def test_stuck_rocking_screen_agrees_with_the_event_functions():
+    """The span's screen of a mode-3 step (signs of the numerators) says 'clear' exactly when
+    every event function of mode 3 is >= 0: random forces and rotations around each boundary
+    (friction cones, normal forces, theta = 0 and theta_c) on both pivots."""
+    system = ShipBlockSystem(ship_mass=2e4, block_mass=1500.0, n_blocks=4, half_width=0.15,
+                             half_height=0.6, mu_s_ground=0.6, mu_k_ground=0.5,
+                             mu_s_ship=0.4, mu_k_ship=0.3)
+    p = parameter_tuple(system.to_parameter_vector())
+    rng = np.random.default_rng(17)
+    g = np.empty(N_EVENTS)
+    y = np.zeros(N_STATE)
+    seen = set()
+    for trial in range(4000):
+        s = 1 if trial % 2 else -1
+        ms = np.zeros(6, np.int64)
+        ms[MS_ROCK] = 1
+        ms[MS_S] = s
+        weight = (system.total_block_mass + system.ship_mass) * system.g
+        fy = rng.normal(1.0, 0.6) * weight
+        Fy = rng.normal(1.0, 0.6) * system.ship_mass * system.g
+        # horizontal forces near the friction limits
+        fx = rng.choice([-1, 1]) * system.mu_s_ground * abs(fy) * rng.uniform(0.8, 1.2)
+        Fx = rng.choice([-1, 1]) * system.mu_s_ship * abs(Fy) * rng.uniform(0.8, 1.2)
+        theta = s * system.critical_angle * rng.uniform(-0.2, 1.2)
+        y[Y_TH] = theta
+        event_functions(p, ms, y, fx, fy, Fx, Fy, g)
+        clear = stuck_rocking_clear(p, float(s), theta, fx, fy, Fx, Fy)
+        assert clear == bool(np.all(g >= 0.0)), (trial, g)
+        seen.update((clear, int(e)) for e in np.nonzero(g < 0.0)[0])
+        seen.add((clear, -1))
+    # both verdicts, and each of the six mode-3 constraints violated at least once
+    assert {c for c, _ in seen} == {True, False}
+    assert len({e for c, e in seen if e >= 0}) == 6

@@ -83,3 +83,15 @@ def event_functions(p, ms, y, fx, fy, Fx, Fy, g):
         g[EV_S_STICK] = (p[P_MUS2] * Fy - abs(Fx)) / ship_weight
     g[EV_SEP_G] = fy / weight
     g[EV_SEP_S] = Fy / ship_weight
+
+
+@njit(cache=True, inline="always")
+def stuck_rocking_clear(p, s, theta, fx, fy, Fx, Fy):
+    """Whether every event function of mode 3 (rocking, no interface slipping) is >= 0.
+
+    The signs of the numerators of :func:`event_functions` for that mode (it divides them by
+    positive weights), without the divisions or the array: the screen of the rocking span's
+    steps. ``s`` is the pivot sign as a float.
+    """
+    return (p[P_MUS1] * fy - abs(fx) >= 0.0 and p[P_MUS2] * Fy - abs(Fx) >= 0.0
+            and fy >= 0.0 and Fy >= 0.0 and s * theta >= 0.0 and p[P_THC] - s * theta >= 0.0)

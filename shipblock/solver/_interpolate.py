@@ -54,12 +54,6 @@ def poly5_slope(c1, c2, c3, c4, c5, u):
     return c1 + u * (2.0 * c2 + u * (3.0 * c3 + u * (4.0 * c4 + u * 5.0 * c5)))
 
 
-@njit(cache=True)
-def poly5_curvature(c2, c3, c4, c5, u):
-    """Second derivative of the quintic with respect to ``u``."""
-    return 2.0 * c2 + u * (6.0 * c3 + u * (12.0 * c4 + u * 20.0 * c5))
-
-
 @njit(cache=True, inline="always")
 def quintic_and_slope(c0, c1, c2, c3, c4, c5, u):
     """Value and derivative of the quintic at ``u``: one Horner pass, fused (two short chains)."""

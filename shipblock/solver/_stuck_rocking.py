@@ -43,7 +43,7 @@ from shipblock.equations import (
     stuck_rocking_rates,
 )
 from shipblock.solver._dopri import DP_A, DP_C, DP_E
-from shipblock.solver._events import event_functions, rearm
+from shipblock.solver._events import event_functions, rearm, stuck_rocking_clear
 from shipblock.solver._fused import fma
 from shipblock.solver._history import store_sample
 from shipblock.solver._interpolate import bracketed_root, quintic_hermite, rotation_peak
@@ -65,7 +65,7 @@ from shipblock.solver._layout import (
     Y_XB,
     Y_XS,
 )
-from shipblock.system import P_G, P_M, P_MUS1, P_MUS2, P_NM, P_R, P_THC
+from shipblock.system import P_G, P_M, P_NM, P_R
 
 #: Largest |delta| [rad] for the series of :func:`small_angle_sincos` (truncation below 1e-17
 #: relative); beyond it the stage takes its own sine and cosine.
@@ -476,11 +476,9 @@ def checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0
     if (e_th * sc_om) ** 2 + (e_om * sc_th) ** 2 <= N_DYN * (sc_th * sc_om) ** 2:
         fx1, fy1, Fx1, Fy1 = stuck_rocking_forces(p, c1, sn1, s, om1, al1, a1, p[P_G] + b1)
         y[Y_TH] = th1
-        # the usual case first: every event function of mode 3 clear of zero, read off the
-        # signs of their numerators (event_functions divides them by positive weights), and
-        # the rotation not dipping through zero inside the step
-        clear = (p[P_MUS1] * fy1 - abs(fx1) >= 0.0 and p[P_MUS2] * Fy1 - abs(Fx1) >= 0.0
-                 and fy1 >= 0.0 and Fy1 >= 0.0 and s * th1 >= 0.0 and p[P_THC] - s * th1 >= 0.0)
+        # the usual case first: every event function clear of zero (read off the signs of
+        # their numerators) and the rotation not dipping through zero inside the step
+        clear = stuck_rocking_clear(p, s, th1, fx1, fy1, Fx1, Fy1)
         quiet = clear and not (armed[EV_IMPACT] and s * th > 0.0 and s * om < 0.0
                                and s * om1 > 0.0)
         if need_g or not clear:
