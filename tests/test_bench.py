@@ -148,3 +148,60 @@ def test_samples_counted_stop_where_a_run_fails():
     failed_at = summ["failure_time"][0]
     assert n == pytest.approx(failed_at / dt + 1 + t.size, rel=1e-12)
     assert n < 1.5 * t.size  # not the 2 x 2000 input samples
+
+
+def test_interleaved_times_alternate_the_calls_on_their_threads():
+    """Each round calls every function once, in order, on its own thread count; restored after."""
+    import numba
+
+    calls_seen = []
+
+    def probe(tag):
+        def call():
+            calls_seen.append((tag, numba.get_num_threads()))
+            return tag
+        return call
+
+    before = numba.get_num_threads()
+    n = numba.config.NUMBA_NUM_THREADS
+    times, results = bench.interleaved_times([(1, probe("a")), (n, probe("b"))], 0.0,
+                                             min_rounds=3)
+    assert times.shape == (3, 2) and np.all(times >= 0)
+    assert calls_seen == [("a", 1), ("b", n)] * 3
+    assert results == ["a", "b"]
+    assert numba.get_num_threads() == before
+
+
+def test_control_loop_lasts_about_what_was_asked():
+    """The control loop is calibrated to the requested length (loosely: machines vary)."""
+    import time
+
+    import numba
+
+    loop = bench.control_loop(0.02)
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        took = []
+        for _ in range(5):
+            t0 = time.perf_counter()
+            loop()
+            took.append(time.perf_counter() - t0)
+    finally:
+        numba.set_num_threads(threads)
+    assert 0.005 < min(took) < 0.08
+
+
+def test_throughput_reports_best_and_median_of_its_window():
+    """Best and median rates from the same calls; samples counted are those integrated."""
+    dt = 0.01
+    t = np.arange(1500) * dt
+    records = [("sine", 3.0 * np.sin(2 * np.pi * t), 0.3 * np.sin(3 * np.pi * t), dt)]
+    r = bench.throughput(bench.rocking_system(), records, scale=1.0, min_seconds=0.05)
+    assert r["rounds"] >= 5
+    assert r["samples_per_s"] == pytest.approx(r["samples"] / r["seconds"])
+    assert r["samples_per_s"] >= r["samples_per_s_median"] > 0
+    assert r["spread"] == pytest.approx(r["samples_per_s"] / r["samples_per_s_median"])
+    assert r["spread"] >= 1.0 and r["control_spread"] >= 1.0
+    assert r["samples"] <= r["input_samples"] == t.size
+    assert r["fraction_rocking"] > 0.1  # the sine rocks the slender blocks
