@@ -217,8 +217,12 @@ def plot_response(result, axes=None, max_event_lines=MAX_IMPACT_LINES, window="a
                              label=f"{n_slip} slip starts and stops: see the mode bands"))
     if not draw_impacts:
         kinds.discard("impact")
-        handles.append(Patch(facecolor="none", edgecolor="none",
-                             label=f"{len(impacts)} impacts: see the zero crossings of theta"))
+        # counted as the summary counts them: an impact that ends rocking is one too
+        n_stops = sum(e.kind == "rocking_stop" for e in result.events)
+        label = f"{len(impacts) + n_stops} impacts: see the zero crossings of theta"
+        if n_stops:
+            label += f" ({n_stops} ending in rest: rocking stop)"
+        handles.append(Patch(facecolor="none", edgecolor="none", label=label))
     handles += [Line2D([], [], **EVENT_STYLES[k], label=k.replace("_", " ")) for k in sorted(kinds)
                 if k in EVENT_STYLES]
     if handles:

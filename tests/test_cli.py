@@ -189,7 +189,13 @@ def test_response_figure_draws_impact_lines_only_when_few():
     many = plot_response(res)
     assert vertical_lines(many) == 3 * n_other
     labels = [txt.get_text() for txt in many[3].get_legend().get_texts()]
-    assert f"{n_imp} impacts: see the zero crossings of theta" in labels
+    # counted as the CLI's summary counts them: the impact that ended rocking is one
+    n_stop = sum(e.kind == "rocking_stop" for e in res.events)
+    assert n_imp + n_stop == res.summary["n_impacts"]
+    expected = f"{n_imp + n_stop} impacts: see the zero crossings of theta"
+    if n_stop:
+        expected += f" ({n_stop} ending in rest: rocking stop)"
+    assert expected in labels
     assert "impact" not in labels
     few = plot_response(res, max_event_lines=n_imp)
     assert vertical_lines(few) == 3 * (n_imp + n_other)
