@@ -205,3 +205,14 @@ def test_throughput_reports_best_and_median_of_its_window():
     assert r["spread"] >= 1.0 and r["control_spread"] >= 1.0
     assert r["samples"] <= r["input_samples"] == t.size
     assert r["fraction_rocking"] > 0.1  # the sine rocks the slender blocks
+
+
+@pytest.mark.parametrize("batch, machine, expected", [
+    (1.9, 1.95, "met"),
+    (1.9, 1.5, "met"),
+    (1.6, 1.95, "NOT met"),
+    (1.6, 1.5, "NOT met, nor did the control loop: the machine allowed no more in this window"),
+])
+def test_scaling_verdict_says_when_the_machine_missed_too(batch, machine, expected):
+    got = bench.scaling_verdict({"speedup": batch, "machine_speedup": machine}, target=1.8)
+    assert got == expected
