@@ -530,12 +530,12 @@ def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campai
     scaling = batch_scaling(rocking_system(), records, 0.3, n_copies=4 if quick else 24,
                             min_seconds=1.0 if quick else 3.0)
     results["batch_scaling"] = scaling
-    out.write(f"batch scaling     : {scaling['speedup']:.2f}x on {scaling['cores']} cores "
+    out.write(f"batch scaling     : {scaling['speedup']:.3f}x on {scaling['cores']} cores "
               f"({scaling['cases']} cases, {scaling['runs_per_s']:.3g} runs/s, results "
               f"{'identical' if scaling['identical'] else 'DIFFERENT'}; target "
               f"{TARGETS['batch_speedup']}x: {scaling_verdict(scaling)}); a pure arithmetic loop "
               f"timed in the same rounds scales "
-              f"{scaling['machine_speedup']:.2f}x (best calls of {scaling['rounds']} rounds; "
+              f"{scaling['machine_speedup']:.3f}x (best calls of {scaling['rounds']} rounds; "
               f"median of the rounds' ratios: batch {scaling['speedup_median']:.2f}x, "
               f"loop {scaling['machine_speedup_median']:.2f}x)\n")
     if pyslammer:
