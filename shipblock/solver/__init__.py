@@ -230,6 +230,43 @@ def _summary_dict(summary: np.ndarray, system: ShipBlockSystem) -> dict:
     return out
 
 
+#: The columns of :func:`simulate_batch`'s cases, as its errors name them.
+CASE_COLUMNS = ("record index", "system index", "horizontal scale", "vertical scale")
+
+
+def _case_columns(cases, n_records, n_systems):
+    """Check a cases table and split it into the kernel's contiguous columns.
+
+    Every entry must be finite and the two indices whole numbers within range: a fractional
+    index would otherwise be truncated to another record, and a NaN scale would run as a
+    record at rest (NaN compares false with every threshold).
+    """
+    table = np.asarray(cases, dtype=float)
+    if table.ndim != 2 or table.shape[1] != 4:
+        raise ParameterError("cases must have shape (n_cases, 4): record, system, scale_h, scale_v")
+    columns = table.T.copy()  # one contiguous row per column
+    if not np.isfinite(columns).all():
+        col, row = np.argwhere(~np.isfinite(columns))[0]
+        raise ParameterError(f"cases[{row}, {col}] ({CASE_COLUMNS[col]}) is {columns[col, row]}: "
+                             "every entry of cases must be finite")
+    idx = columns[:2].astype(np.int64)
+    if not (idx == columns[:2]).all():
+        col, row = np.argwhere(idx != columns[:2])[0]
+        raise ParameterError(f"cases[{row}, {col}] ({CASE_COLUMNS[col]}) is {columns[col, row]}: "
+                             "an index must be a whole number")
+    if idx.shape[1]:
+        (lo_r, lo_s), (hi_r, hi_s) = idx.min(axis=1).tolist(), idx.max(axis=1).tolist()
+        if lo_r < 0 or hi_r >= n_records or lo_s < 0 or hi_s >= n_systems:
+            for col, n, what in ((0, n_records, "record"), (1, n_systems, "system")):
+                bad = (idx[col] < 0) | (idx[col] >= n)
+                if bad.any():
+                    row = int(np.argmax(bad))
+                    raise ParameterError(
+                        f"a case refers to a {what} index out of range: cases[{row}, {col}] is "
+                        f"{idx[col, row]}, with {n} {what}{'s' if n != 1 else ''}")
+    return idx[0], idx[1], columns[2], columns[3]
+
+
 def simulate_batch(
     systems: ShipBlockSystem | Sequence[ShipBlockSystem],
     records: Sequence | RecordSet,
@@ -257,7 +294,8 @@ def simulate_batch(
         Sample interval of each record [s]; required with a sequence of records, not given
         with a :class:`RecordSet` (which holds its own).
     cases : array_like, shape (n_cases, 4)
-        Rows ``(record_index, system_index, scale_h, scale_v)``.
+        Rows ``(record_index, system_index, scale_h, scale_v)``: finite, the indices whole
+        numbers within range (``CASE_COLUMNS`` names the columns in the errors).
     rtol, atol, zeno_omega : float, optional
         As for :func:`simulate`.
 
@@ -281,17 +319,8 @@ def simulate_batch(
         packed = RecordSet(records, dts)
     if cases is None:
         raise ParameterError("cases is required: rows (record, system, scale_h, scale_v)")
-    n_rec = len(packed)
-    cases = np.asarray(cases, dtype=float)
-    if cases.ndim != 2 or cases.shape[1] != 4:
-        raise ParameterError("cases must have shape (n_cases, 4): record, system, scale_h, scale_v")
-    rec_idx = cases[:, 0].astype(np.int64)
-    par_idx = cases[:, 1].astype(np.int64)
-    if rec_idx.min(initial=0) < 0 or rec_idx.max(initial=0) >= n_rec:
-        raise ParameterError("a case refers to a record index out of range")
-    if par_idx.min(initial=0) < 0 or par_idx.max(initial=0) >= len(params):
-        raise ParameterError("a case refers to a system index out of range")
-    summaries = np.empty((cases.shape[0], K.N_SUMMARY))
+    rec_idx, par_idx, scale_h, scale_v = _case_columns(cases, len(packed), len(params))
+    summaries = np.empty((rec_idx.size, K.N_SUMMARY))
     K.run_many(
         params,
         packed.acc_h,
@@ -301,8 +330,8 @@ def simulate_batch(
         packed.has_v,
         rec_idx,
         par_idx,
-        np.ascontiguousarray(cases[:, 2]),
-        np.ascontiguousarray(cases[:, 3]),
+        scale_h,
+        scale_v,
         rtol,
         atol,
         zeno_omega,
