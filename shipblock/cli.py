@@ -484,7 +484,9 @@ def build_parser():
 
     s = sub.add_parser("plot", help="figure from a results NetCDF (response or fragility)")
     s.add_argument("results", help="NetCDF written by 'simulate' or 'run'")
-    s.add_argument("--figure", "-o", help="PNG path (default: next to the results)")
+    # --output too: 'simulate' and 'history' name their NetCDF so, and here the output is the PNG
+    s.add_argument("--figure", "--output", "-o", dest="figure",
+                   help="PNG path (default: next to the results)")
     s.add_argument("--kind", choices=["fragility", "ida"], default="fragility",
                    help="for batch results: fragility curves (default) or IDA curves")
     s.add_argument("--edp", default="peak_ship_slip", help="demand parameter of the IDA curves")

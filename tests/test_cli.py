@@ -33,6 +33,9 @@ def test_simulate_shipped_record_writes_netcdf_and_figure(tmp_path, capsys):
     assert np.abs(ds["ground_acceleration_h"]).max() / STANDARD_GRAVITY > 1.0
     code, out, _ = run(capsys, "plot", str(nc), "--figure", str(tmp_path / "again.png"))
     assert code == 0 and (tmp_path / "again.png").exists()
+    # a newcomer's --output, as for simulate, names the figure of plot
+    code, out, _ = run(capsys, "plot", str(nc), "--output", str(tmp_path / "once_more.png"))
+    assert code == 0 and (tmp_path / "once_more.png").exists()
 
 
 def test_info_reports_pga_of_the_readme_table(capsys):
