@@ -304,24 +304,6 @@ def batch_scaling(system, records, scale, n_copies=8, min_seconds=3.0):
             "rounds": len(times), "identical": identical, "runs_per_s": len(cases) / best[1]}
 
 
-def machine_scaling(seconds=0.25, min_seconds=2.0):
-    """Speed-up of a pure arithmetic parallel loop from one core to all: the machine's ceiling.
-
-    No memory traffic, no shared data, equal work per thread (:func:`control_loop`, about
-    ``seconds`` on one thread), one and all threads in alternation for ``min_seconds``. On
-    virtual machines whose cores are hyper-threads or share a CPU quota this is well below the
-    number of cores, and no batch of simulations can scale better.
-    """
-    import numba
-
-    n_threads = numba.config.NUMBA_NUM_THREADS
-    control = control_loop(seconds)
-    times, _ = interleaved_times([(1, control), (n_threads, control)], min_seconds)
-    best = times.min(axis=0)
-    return {"cores": n_threads, "speedup": best[0] / best[1],
-            "speedup_median": float(np.median(times[:, 0] / times[:, 1]))}
-
-
 def pyslammer_comparison(ky_g=0.1, rounds=5):
     """Time pySLAMMER's RigidAnalysis vs shipblock on pySLAMMER's sample records.
 
