@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 from shipblock.units import STANDARD_GRAVITY
@@ -32,6 +33,36 @@ SYSTEM_FLAGS = {
 
 class UserError(Exception):
     """An error caused by the user's input: reported in one line, no traceback."""
+
+
+#: Said once when a command starts compiling (numba's cache empty: a fresh install or new numba).
+COMPILE_NOTICE = ("compiling shipblock's solver for this machine: a minute or two the first time, "
+                  "kept in numba's cache for later runs")
+
+
+@contextmanager
+def compile_notice(say):
+    """Call ``say()`` once if numba compiles anything within the block.
+
+    Loading a function from numba's on-disk cache is not a compilation, so ``say`` runs only
+    on a first use, where a progress bar would otherwise sit at 0 % for a minute or two with no
+    word of why. Uses numba's event API (``numba:compile`` is triggered on a cache miss only).
+    """
+    from numba.core import event
+
+    class _Once(event.Listener):
+        said = False
+
+        def on_start(self, ev):
+            if not self.said:
+                self.said = True
+                say()
+
+        def on_end(self, ev):
+            pass
+
+    with event.install_listener("numba:compile", _Once()):
+        yield
 
 
 # --------------------------------------------------------------------------- record input
@@ -519,7 +550,8 @@ def main(argv=None):
     from shipblock.errors import ShipblockError
 
     try:
-        return args.func(args)
+        with compile_notice(lambda: log.info(COMPILE_NOTICE)):
+            return args.func(args)
     except (UserError, ShipblockError, ValueError, FileNotFoundError, OSError) as exc:
         if args.verbose > 1:
             raise

@@ -220,3 +220,28 @@ def test_run_says_why_a_limit_state_was_not_fitted(tmp_path, capsys):
             assert "not fitted: " in line and error.split(": ", 1)[-1] in line
         else:
             assert "median" in line
+
+
+def test_compile_notice_speaks_once_and_only_when_numba_compiles():
+    """A first use compiles (the notice is said once, however many functions compile); a
+    function already compiled, or loaded from the cache, is not a compilation."""
+    import numba
+
+    from shipblock.cli import compile_notice
+
+    said = []
+
+    @numba.njit
+    def twice(x):
+        return 2.0 * x
+
+    @numba.njit
+    def thrice(x):
+        return 3.0 * twice(x) / 2.0
+
+    with compile_notice(lambda: said.append(1)):
+        assert thrice(1.0) == 3.0  # compiles both
+    assert said == [1]
+    with compile_notice(lambda: said.append(2)):
+        assert thrice(2.0) == 6.0  # already compiled
+    assert said == [1]
