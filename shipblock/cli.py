@@ -550,7 +550,10 @@ def main(argv=None):
     from shipblock.errors import ShipblockError
 
     try:
-        with compile_notice(lambda: log.info(COMPILE_NOTICE)):
+        from tqdm.contrib.logging import logging_redirect_tqdm
+
+        # log lines go above a progress bar, not onto its line
+        with logging_redirect_tqdm(), compile_notice(lambda: log.info(COMPILE_NOTICE)):
             return args.func(args)
     except (UserError, ShipblockError, ValueError, FileNotFoundError, OSError) as exc:
         if args.verbose > 1:
