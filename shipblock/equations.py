@@ -323,9 +323,17 @@ def kinetic_energy(p, theta, s, rock, vb, om, vs):
 
 @njit(cache=True)
 def potential_energy(p, theta):
-    """Gravity potential energy above the rest position, (nm+2M) g R (cos phi - cos theta_c) [J]."""
-    phi = p[P_THC] - abs(theta)
-    return (p[P_NM] + 2.0 * p[P_M]) * p[P_G] * p[P_R] * (math.cos(phi) - math.cos(p[P_THC]))
+    r"""Gravity potential energy above the rest position [J].
+
+    :math:`(nm+2M)\,gR\,(\cos\varphi - \cos\theta_c)` with :math:`\varphi = \theta_c - |\theta|`,
+    evaluated as :math:`2\sin(\theta_c - |\theta|/2)\sin(|\theta|/2)`: the difference of
+    cosines loses the relative precision of a small rotation (all of it below about 1e-16 rad,
+    where a brief uplift's input work is already stored: the energy balance of such a run
+    failed by 100 %).
+    """
+    t = abs(theta)
+    lift = 2.0 * math.sin(p[P_THC] - 0.5 * t) * math.sin(0.5 * t)
+    return (p[P_NM] + 2.0 * p[P_M]) * p[P_G] * p[P_R] * lift
 
 
 @njit(cache=True, inline="always")

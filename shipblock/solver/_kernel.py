@@ -42,7 +42,7 @@ from shipblock.impact import apply_impact
 from shipblock.modes import MODE_NUMBER, EventKind, Failure
 from shipblock.solver._closed_form import mode_response_start, nonrocking_span
 from shipblock.solver._dopri import DP_A, DP_C, DP_E, DP_ERROR_ORDER
-from shipblock.solver._events import event_functions, rearm, rotation_event
+from shipblock.solver._events import event_functions, impact_return_time, rearm, rotation_event
 from shipblock.solver._ground import ground_motion_at
 from shipblock.solver._history import store_sample
 from shipblock.solver._interpolate import (
@@ -742,6 +742,12 @@ summary, y_init
                         failure = Failure.SOLVER_ERROR
                         failure_time = k * dt + tau
                         break
+                    continue
+                t_return = impact_return_time(ms[MS_S], y[Y_TH], y[Y_OM], stages[0, Y_OM])
+                if h > t_return >= MIN_STEP:
+                    # from an impact, no step past the rotation's return to zero: see
+                    # impact_return_time (stages[0] stays f(y) for the shorter step)
+                    h_rock = t_return
                     continue
                 # slopes at both ends (first and last stage) for the interpolants and event checks
                 d_start_b = stages[0, Y_VB]

@@ -43,7 +43,12 @@ from shipblock.equations import (
     stuck_rocking_rates,
 )
 from shipblock.solver._dopri import DP_A, DP_C, DP_E
-from shipblock.solver._events import event_functions, rearm, stuck_rocking_clear
+from shipblock.solver._events import (
+    event_functions,
+    impact_return_time,
+    rearm,
+    stuck_rocking_clear,
+)
 from shipblock.solver._fused import fma
 from shipblock.solver._history import store_sample
 from shipblock.solver._interpolate import bracketed_root, quintic_hermite, rotation_peak
@@ -582,9 +587,15 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
         al, pw = stuck_rocking_rates(p, gain, c, sn, s, om, a0 + (a1 - a0) * f0,
                                      b0 + (b1 - b0) * f0)
         h = dt - tau
-        (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i, w_i,
-         al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0,
-                              1.0 - f0, h, dt, rtol, atol, armed, g1, True, False)
+        if h > impact_return_time(s, th, om, al):
+            # the rest of the sample would pass the rotation's return to zero: the kernel takes
+            # a shorter step (see impact_return_time)
+            verdict = STEP_REFUSED
+        else:
+            (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i,
+             w_i, al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0,
+                                       b1, f0, 1.0 - f0, h, dt, rtol, atol, armed, g1, True,
+                                       False)
         if verdict == STEP_ACCEPTED:
             all_armed = rearm(armed, g1)
             t0 = k * dt + tau
