@@ -97,7 +97,8 @@ def impact_return_time(s, theta, omega, alpha):
     equations run on past the impact with the pivot on the wrong corner) and end on the right
     side of zero, where no check of its ends sees the impact: small rocking after an impact
     then went on with the wrong pivot (found by random testing: energy balances off by up to
-    30 %). Infinite (no limit) otherwise.
+    30 %). Infinite (no limit) otherwise. The kernel's rocking steps and the mode-3 span's
+    first step into a sample both keep to it.
     """
     if theta == 0.0 and s * omega > 0.0 and s * alpha < 0.0:
         return -2.0 * omega / alpha

@@ -580,38 +580,44 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
     verdict = STEP_ACCEPTED
     t_imp = th_i = om_i = w_i = al_i = 0.0
     if tau > 0.0:
-        # the rest of the sample the span starts in
-        f0 = tau / dt
+        # the rest of the sample the span starts in: one step, or two when the first, from an
+        # impact, may not pass the rotation's return to zero (see impact_return_time)
         a1 = sh * ax[k + 1]
         b1 = sv * ay[k + 1] if has_ay else 0.0
-        al, pw = stuck_rocking_rates(p, gain, c, sn, s, om, a0 + (a1 - a0) * f0,
-                                     b0 + (b1 - b0) * f0)
-        h = dt - tau
-        if h > impact_return_time(s, th, om, al):
-            # the rest of the sample would pass the rotation's return to zero: the kernel takes
-            # a shorter step (see impact_return_time)
-            verdict = STEP_REFUSED
-        else:
+        while tau > 0.0 and verdict == STEP_ACCEPTED:
+            f0 = tau / dt
+            al, pw = stuck_rocking_rates(p, gain, c, sn, s, om, a0 + (a1 - a0) * f0,
+                                         b0 + (b1 - b0) * f0)
+            h = dt - tau
+            fh = 1.0 - f0
+            to_sample = h <= impact_return_time(s, th, om, al)
+            if not to_sample:
+                h = impact_return_time(s, th, om, al)
+                fh = h / dt
             (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i,
              w_i, al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0,
-                                       b1, f0, 1.0 - f0, h, dt, rtol, atol, armed, g1, True,
-                                       False)
-        if verdict == STEP_ACCEPTED:
-            all_armed = rearm(armed, g1)
-            t0 = k * dt + tau
-            peak_th, peak_th_time = rotation_peak(peak_th, peak_th_time, th, om, al, th1, om1,
-                                                  al1, h, t0, k * dt + dt)
-            time_in_mode += h
-            k += 1
-            tau = 0.0
-            th, om, w, al, pw, c, sn, a0, b0 = th1, om1, w1, al1, pw1, c1, sn1, a1, b1
-            fx, fy, Fx, Fy = fx1, fy1, Fx1, Fy1
-            forces_known = True
-            y[Y_TH] = th
-            y[Y_OM] = om
-            y[Y_WIN] = w
-            if store:
-                store_sample(p, ms, y, hist, modes, k, mode)
+                                       b1, f0, fh, h, dt, rtol, atol, armed, g1, True, False)
+            if verdict == STEP_ACCEPTED:
+                all_armed = rearm(armed, g1)
+                t0 = k * dt + tau
+                peak_th, peak_th_time = rotation_peak(peak_th, peak_th_time, th, om, al, th1,
+                                                      om1, al1, h, t0,
+                                                      k * dt + dt if to_sample else t0 + h)
+                time_in_mode += h
+                th, om, w, al, pw, c, sn = th1, om1, w1, al1, pw1, c1, sn1
+                fx, fy, Fx, Fy = fx1, fy1, Fx1, Fy1
+                forces_known = True
+                y[Y_TH] = th
+                y[Y_OM] = om
+                y[Y_WIN] = w
+                if to_sample:
+                    k += 1
+                    tau = 0.0
+                    a0, b0 = a1, b1
+                    if store:
+                        store_sample(p, ms, y, hist, modes, k, mode)
+                else:
+                    tau += h
     else:
         al, pw = stuck_rocking_rates(p, gain, c, sn, s, om, a0, b0)
     while verdict == STEP_ACCEPTED and k < n - 1:
@@ -642,7 +648,7 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
     if abs(th) > peak_th:
         # the end of the last step accepted (as rotation_peak would have timed it)
         peak_th = abs(th)
-        peak_th_time = (k - 1) * dt + dt if time_in_mode > 0.0 else k * dt + tau
+        peak_th_time = (k - 1) * dt + dt if time_in_mode > 0.0 and tau == 0.0 else k * dt + tau
     if verdict == STEP_TO_IMPACT:
         t0 = k * dt + tau
         peak_th, peak_th_time = rotation_peak(peak_th, peak_th_time, th, om, al, th_i, om_i, al_i,
