@@ -590,9 +590,10 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
                                          b0 + (b1 - b0) * f0)
             h = dt - tau
             fh = 1.0 - f0
-            to_sample = h <= impact_return_time(s, th, om, al)
+            t_return = impact_return_time(s, th, om, al)
+            to_sample = h <= t_return
             if not to_sample:
-                h = impact_return_time(s, th, om, al)
+                h = t_return
                 fh = h / dt
             (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i,
              w_i, al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0,
