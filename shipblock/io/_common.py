@@ -311,3 +311,61 @@ def make_trace(data, delta: float, stats: dict) -> Trace:
     for key, value in stats.items():
         trace.stats[key] = value
     return trace
+
+
+#: Largest departure from north or east [deg] for which a horizontal is named N or E.
+CARDINAL_TOLERANCE_DEG = 1.0
+
+
+def band_code(sampling_rate: float) -> str:
+    """SEED band code of an accelerometer channel for its sampling rate [Hz].
+
+    ``"H"`` at 80 Hz or more, ``"B"`` from 10 Hz, ``"M"`` from 1 Hz, ``"L"`` below (SEED manual,
+    appendix A, for the broadband codes accelerometers share with seismometers).
+    """
+    if sampling_rate >= 80.0:
+        return "H"
+    if sampling_rate >= 10.0:
+        return "B"
+    if sampling_rate > 1.0:
+        return "M"
+    return "L"
+
+
+def orientation_stats(sampling_rate: float, *, vertical: bool, azimuth_deg: float | None = None,
+                      positive_up: bool = True, index: int = 1) -> dict:
+    """Channel code, azimuth and dip of an accelerometer component, as ``trace.stats`` entries.
+
+    Parameters
+    ----------
+    sampling_rate : float
+        Samples per second [Hz] (chooses the band code).
+    vertical : bool
+        Whether the component is vertical.
+    azimuth_deg : float, optional
+        Azimuth of a horizontal's positive direction [deg clockwise from north]; ``None`` if the
+        file does not state it.
+    positive_up : bool, optional
+        For a vertical: whether positive samples mean up (``dip = -90``) or down (``dip = 90``).
+    index : int, optional
+        ``1`` or ``2``: the digit a horizontal gets when it is not along north or east.
+
+    Returns
+    -------
+    dict
+        ``channel`` (``HNZ``, ``HNN``, ``HNE``, ``HN1``/``HN2``; band letter by rate), ``dip``
+        [deg, SEED: positive down] and, for a horizontal of known azimuth, ``azimuth`` [deg].
+    """
+    band = band_code(sampling_rate)
+    if vertical:
+        return {"channel": f"{band}NZ", "dip": -90.0 if positive_up else 90.0}
+    stats = {"dip": 0.0}
+    letter = str(index)
+    if azimuth_deg is not None and math.isfinite(azimuth_deg):
+        azimuth = float(azimuth_deg) % 360.0
+        stats["azimuth"] = azimuth
+        for cardinal, target in (("N", 0.0), ("E", 90.0)):
+            if min(abs(azimuth - target), 360.0 - abs(azimuth - target)) <= CARDINAL_TOLERANCE_DEG:
+                letter = cardinal
+    stats["channel"] = f"{band}N{letter}"
+    return stats
