@@ -16,12 +16,12 @@ from pathlib import Path
 from shipblock.errors import RecordError
 from shipblock.motion import COMPONENTS, GroundMotion, read_motion
 
-__all__ = ["CatalogueEntry", "default_catalogue_path", "load_catalogue"]
+__all__ = ["CatalogueEntry", "catalogue_toml", "default_catalogue_path", "load_catalogue"]
 
 #: Catalogue layout version this module reads.
 SCHEMA_VERSION = 1
 
-_REQUIRED = ("id", "files", "station", "license", "credit")
+_REQUIRED = ("id", "files", "station")
 
 
 def default_catalogue_path() -> Path:
@@ -54,7 +54,7 @@ class CatalogueEntry:
     site : str
         Site description.
     license, credit : str
-        Terms of use and the credit line to give.
+        Terms of use and the credit line to give (empty when not known: a private record).
     components : dict
         Channel code (or file name) -> ``"H1"``, ``"H2"`` or ``"V"``.
     units : str or None
@@ -146,8 +146,8 @@ def _entry(table: dict, base: Path, catalogue: Path) -> CatalogueEntry:
         network=str(table.get("network", "")),
         station=str(table["station"]),
         site=str(table.get("site", "")),
-        license=str(table["license"]),
-        credit=str(table["credit"]),
+        license=str(table.get("license", "")),
+        credit=str(table.get("credit", "")),
         components=components,
         units=table.get("units"),
         extra={k: v for k, v in table.items() if k not in known},
@@ -192,3 +192,142 @@ def load_catalogue(path=None) -> dict[str, CatalogueEntry]:
             raise RecordError(catalogue, f"record id {entry.id!r} appears twice")
         entries[entry.id] = entry
     return entries
+
+
+# --------------------------------------------------------------------------------------------
+# Writing a catalogue from a folder of records
+# --------------------------------------------------------------------------------------------
+
+
+def _toml_value(value) -> str:
+    """A TOML literal for a string, number or list of them (JSON's string escapes are TOML's)."""
+    import json
+    import math
+
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        if isinstance(value, float) and not math.isfinite(value):
+            raise ValueError(f"cannot write {value!r} to TOML")
+        return repr(float(value)) if isinstance(value, float) else str(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    return json.dumps(str(value), ensure_ascii=False)
+
+
+def _relative(path, base: Path) -> str:
+    import os
+
+    return Path(os.path.relpath(Path(path).resolve(), base)).as_posix()
+
+
+def _inventory_file(motion, inventories) -> Path | None:
+    """The StationXML file among ``inventories`` that holds the motion's station."""
+    import warnings
+
+    import obspy
+
+    station = motion.metadata.get("station") or {}
+    for path in inventories:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                inventory = obspy.read_inventory(str(path))
+        except Exception:  # noqa: BLE001 - read_motions already reported it
+            continue
+        if len(inventory.select(network=station.get("network"), station=station.get("station"))):
+            return Path(path)
+    return None
+
+
+def catalogue_toml(motions, output, licence: str | None = None, credit: str | None = None,
+                   units: str | None = None) -> str:
+    """The text of a record catalogue for the records of a :class:`~shipblock.collection.MotionSet`.
+
+    Each record becomes a ``[[record]]`` table that :func:`load_catalogue` reads back: id
+    (``NET.STA.LOC.SENSOR``), files and StationXML inventory relative to the catalogue's folder,
+    the channel -> component mapping, station, event, format, sampling interval ``dt_s``,
+    duration ``duration_s``, start time and the peak of each component (``pga_m_s2`` and
+    ``pga_g``: of the record as read, before any processing). ``license`` and ``credit`` are
+    written when given (a private record has none). Files and groups that could not be read are
+    listed in comments at the top.
+
+    Parameters
+    ----------
+    motions : MotionSet
+        From :func:`shipblock.collection.read_motions`.
+    output : str or os.PathLike
+        Where the catalogue will be written (paths in it are relative to its folder).
+    licence, credit : str, optional
+        Terms of use and credit line of the records.
+    units : str, optional
+        The ``units=`` the records were read with (stored so that they read back the same).
+
+    Returns
+    -------
+    str
+        TOML text.
+    """
+    import numpy as np
+
+    from shipblock.units import STANDARD_GRAVITY
+
+    base = Path(output).resolve().parent
+    inventories = [Path(p) for p in motions.skipped if p.lower().endswith(".xml")]
+    lines = [
+        "# Record catalogue written by 'shipblock catalogue'. One [[record]] table per station",
+        "# sensor; paths are relative to this file. pga_* are peaks of the records as read (before",
+        "# baseline correction and filtering).",
+        f"# {len(motions.motions)} records; {len(motions.failures)} files or groups not used:",
+    ]
+    lines += [f"#   {where}: {why}".replace("\n", " ") for where, why in motions.failures]
+    lines += ["", f"schema_version = {SCHEMA_VERSION}", ""]
+    seen: dict[str, int] = {}
+    for motion in motions.motions:
+        md = motion.metadata
+        station = md.get("station") or {}
+        first = motion.stream[0]
+        record_id = ".".join([station.get("network", ""), station.get("station", ""),
+                              station.get("location", ""), first.stats.channel[:2]])
+        seen[record_id] = seen.get(record_id, 0) + 1
+        if seen[record_id] > 1:
+            record_id += f"-{seen[record_id]}"
+        table = {
+            "id": record_id,
+            "files": [_relative(f, base) for f in md.get("source_files", [])],
+            "network": station.get("network", ""),
+            "station": station.get("station", ""),
+            "location": station.get("location", ""),
+            "format": str(first.stats.get("_format", "")),
+            "starttime": str(motion.starttime),
+            "dt_s": float(motion.dt),
+            "npts": int(motion.npts),
+            "duration_s": float(motion.dt * (motion.npts - 1)),
+        }
+        inventory = _inventory_file(motion, inventories) if md.get("inventory") else None
+        if inventory is not None:
+            table["inventory"] = _relative(inventory, base)
+        if units:
+            table["units"] = units
+        event = md.get("event") or {}
+        if event.get("id") or event.get("name"):
+            table["event_name"] = str(event.get("id") or event.get("name"))
+        coordinates = station.get("coordinates") or {}
+        for key in ("latitude", "longitude"):
+            if coordinates.get(key) is not None:
+                table[key] = float(coordinates[key])
+        if licence:
+            table["license"] = licence
+        if credit:
+            table["credit"] = credit
+        for component, data in motion.components.items():
+            peak = float(np.max(np.abs(data)))
+            table[f"pga_{component}_m_s2"] = peak
+            table[f"pga_{component}_g"] = peak / STANDARD_GRAVITY
+        lines.append("[[record]]")
+        lines += [f"{key} = {_toml_value(value)}" for key, value in table.items()]
+        lines += ["", "[record.components]    # channel code -> component"]
+        for component, seed_id in md.get("channels", {}).items():
+            lines.append(f"{_toml_value(seed_id)} = {_toml_value(component)}")
+        lines.append("")
+    return "\n".join(lines)

@@ -68,17 +68,35 @@ def compile_notice(say):
 # --------------------------------------------------------------------------- record input
 def _add_record_arguments(p):
     g = p.add_argument_group("record")
-    g.add_argument("files", nargs="*", help="record files (MiniSEED, SAC, AT2, COSMOS, ESM, text, ...)")
+    g.add_argument("files", nargs="*",
+                   help="record files (MiniSEED, SAC, K-NET/KiK-net, CSMIP, COSMOS, GeoNet, ESM,"
+                        " AT2, ...), or a folder or glob pattern holding one record")
     g.add_argument("--record", help="id of a catalogue record, e.g. NP.1765 or south-napa-2014/NP.1765")
     g.add_argument("--catalogue", help="record catalogue TOML (default: the shipped one)")
-    g.add_argument("--inventory", help="StationXML for raw counts")
-    g.add_argument("--units", help="units of records that do not state them: m/s^2, cm/s^2, gal, g")
+    _add_conversion_arguments(g)
     g.add_argument("--azimuth", type=float,
                    help="dock transverse axis [deg clockwise from north]: horizontals rotated to it")
     g.add_argument("--horizontal", choices=["H1", "H2"], help="use this horizontal component")
     g.add_argument("--processing", default="default",
                    help="'default' (the documented chain), 'demean', 'none', or a TOML file with "
                         "[[processing]] steps")
+
+
+def _add_conversion_arguments(g):
+    g.add_argument("--inventory", help="StationXML for raw counts (and channel orientations)")
+    g.add_argument("--units", help="units of records that do not state them: m/s^2, cm/s^2, gal,"
+                                   " g, or velocity m/s, cm/s (with --differentiate)")
+    g.add_argument("--response", choices=["sensitivity", "full"], default="sensitivity",
+                   help="with --inventory: divide by the overall sensitivity (default) or remove"
+                        " the full instrument response")
+    g.add_argument("--differentiate", action="store_true",
+                   help="differentiate velocity records to acceleration (said in the provenance)")
+    g.add_argument("--sensor", help="sensor to use when a station has several: LOC.CODE, e.g."
+                                    " 02.HN (KiK-net surface) or HN")
+
+
+def _conversion_kwargs(args) -> dict:
+    return {"response": args.response, "differentiate": args.differentiate}
 
 
 def _find_entry(record_id, catalogue):
@@ -126,14 +144,18 @@ def _load_motion(args):
         raise UserError("give either --record or record files, not both")
     if args.record:
         entry = _find_entry(args.record, args.catalogue)
-        motion = entry.read(azimuth=args.azimuth, horizontal=args.horizontal)
+        motion = entry.read(azimuth=args.azimuth, horizontal=args.horizontal,
+                            **_conversion_kwargs(args))
     elif args.files:
+        import glob
+
         for f in args.files:
-            if not Path(f).exists():
+            if not Path(f).exists() and not glob.has_magic(f):
                 raise UserError(f"{f}: no such file")
         motion = read_motion(args.files if len(args.files) > 1 else args.files[0],
                              inventory=args.inventory, units=args.units, azimuth=args.azimuth,
-                             horizontal=args.horizontal)
+                             horizontal=args.horizontal, sensor=args.sensor,
+                             **_conversion_kwargs(args))
     else:
         raise UserError("no record: give record files or --record ID (see 'shipblock info --help')")
     chain = _processing_chain(args.processing)
@@ -335,6 +357,35 @@ def cmd_info(args):
     return 0
 
 
+def cmd_catalogue(args):
+    from shipblock.catalogue import catalogue_toml, load_catalogue
+    from shipblock.collection import read_motions
+
+    found = read_motions(args.sources, inventory=args.inventory, units=args.units,
+                         **_conversion_kwargs(args))
+    for where, why in found.failures:
+        log.warning("not used: %s: %s", where, why)
+    if not found.motions:
+        raise UserError(f"no record could be read from {', '.join(args.sources)}"
+                        f" ({len(found.failures)} failures listed above)")
+    text = catalogue_toml(found, args.output, licence=args.license, credit=args.credit,
+                          units=args.units)
+    output = Path(args.output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    partial = output.with_name(output.name + ".part")
+    partial.write_text(text)
+    partial.replace(output)
+    load_catalogue(output)  # what was written reads back
+    sys.stdout.write(f"{len(found.motions)} records written to {output}; "
+                     f"{len(found.failures)} files or groups not used\n")
+    for motion in found.motions:
+        peaks = "  ".join(f"{c} {abs(a).max() / STANDARD_GRAVITY:.4f} g"
+                          for c, a in motion.components.items())
+        sensor = next(iter(motion.metadata.get("channels", {}).values()), motion.name)[:-1]
+        sys.stdout.write(f"  {sensor:<20} dt {motion.dt:g} s  {motion.npts:>7} samples  {peaks}\n")
+    return 0
+
+
 def cmd_process(args):
     import csv
 
@@ -489,6 +540,19 @@ def build_parser():
     s.add_argument("--output-dir", "-o", default="processed", help="output folder")
     s.add_argument("--format", default="MSEED", choices=["MSEED", "SAC", "mseed", "sac"])
     s.set_defaults(func=cmd_process)
+
+    s = sub.add_parser("catalogue", help="read a folder of agency records into a catalogue TOML",
+                       description="Read every record file of folders or glob patterns, group"
+                       " the files into one record per station sensor, and write a catalogue"
+                       " (station, event, dt, duration, PGA per component, source files). Files"
+                       " that cannot be read are listed with their reasons.")
+    s.add_argument("sources", nargs="+", help="folders, glob patterns or files")
+    s.add_argument("--output", "-o", default="catalogue.toml", help="catalogue TOML to write")
+    g = s.add_argument_group("conversion")
+    _add_conversion_arguments(g)
+    s.add_argument("--license", "--licence", dest="license", help="licence of the records")
+    s.add_argument("--credit", help="credit line of the records")
+    s.set_defaults(func=cmd_catalogue)
 
     s = sub.add_parser("run", help="run a pipeline file (batch, fragility)")
     s.add_argument("pipeline", help="pipeline TOML, e.g. pipelines/demo.toml")

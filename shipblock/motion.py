@@ -36,7 +36,8 @@ from obspy import Stream, Trace, UTCDateTime
 
 from shipblock.errors import ParameterError, RecordError, ShipblockError, UnitsError
 from shipblock.io import read_record
-from shipblock.io._common import si_factor
+from shipblock.io._common import canonical_unit, si_factor
+from shipblock.units import STANDARD_GRAVITY, VELOCITY_UNITS_TO_SI
 
 __all__ = [
     "COMPONENTS",
@@ -78,7 +79,30 @@ CALIB_IN_SI_FORMATS = {
     "KINEMETRICS_EVT": "Kinemetrics EVT full scale and sensitivity",
 }
 
-_ACCELERATION_INPUT_UNITS = {"M/S**2", "M/S^2", "M/S/S", "M/S2", "M/(S**2)"}
+#: Input units of a StationXML response (upper case, no blanks) -> (quantity, factor to SI).
+INPUT_UNITS_TO_SI: dict[str, tuple[str, float]] = {
+    **{u: ("acceleration", 1.0) for u in ("M/S**2", "M/S^2", "M/S/S", "M/S2", "M/(S**2)", "M/SEC**2")},
+    **{u: ("acceleration", 1e-2) for u in ("CM/S**2", "CM/S^2", "CM/S/S", "CM/S2", "GAL")},
+    **{u: ("acceleration", 1e-3) for u in ("MM/S**2", "MM/S^2", "MM/S/S", "MM/S2")},
+    **{u: ("acceleration", 1e-9) for u in ("NM/S**2", "NM/S^2", "NM/S/S", "NM/S2")},
+    **{u: ("acceleration", STANDARD_GRAVITY) for u in ("G", "GS")},
+    **{u: ("velocity", 1.0) for u in ("M/S", "M/SEC")},
+    **{u: ("velocity", 1e-2) for u in ("CM/S", "CM/SEC")},
+    **{u: ("velocity", 1e-3) for u in ("MM/S", "MM/SEC")},
+    **{u: ("velocity", 1e-9) for u in ("NM/S", "NM/SEC")},
+}
+
+#: SAC's dependent-variable codes (IDEP) that state a unit, and the unit (SAC manual: IACC is
+#: nm/s^2, IVEL nm/s).
+SAC_IDEP_UNITS = {8: "nm/s^2", 7: "nm/s"}
+SAC_IDEP_NAMES = {8: "IACC", 7: "IVEL"}
+
+#: Mean of a vertical above which read_motion notes gravity or an offset in it [m/s^2].
+GRAVITY_NOTE_THRESHOLD = 0.5 * STANDARD_GRAVITY
+
+#: How close to 1 the mean of a vertical may be to be taken for gravity in g [-].
+GRAVITY_MEAN_TOLERANCE = 0.05
+
 _SI_UNITS = "m/s**2"
 
 
@@ -261,6 +285,7 @@ def _merge_gaps(stream: Stream, gaps: str) -> Stream:
 
 
 def _select_channel(trace: Trace, inventory, inventory_name):
+    """The inventory's channel of a trace in force at the trace's start (its epoch)."""
     stats = trace.stats
     selected = inventory.select(
         network=stats.network,
@@ -279,7 +304,118 @@ def _select_channel(trace: Trace, inventory, inventory_name):
     return channels[0]
 
 
-def _to_si(trace: Trace, inventory, inventory_name, units, response) -> str:
+def _input_unit(unit: str | None):
+    """``(quantity, factor to SI)`` of a StationXML/SAC input unit, or ``(None, None)``."""
+    key = (unit or "").strip().upper().replace(" ", "")
+    if key in INPUT_UNITS_TO_SI:
+        return INPUT_UNITS_TO_SI[key]
+    return None, None
+
+
+def _differentiate(trace: Trace, how: str, differentiate: bool, name: str, what: str) -> str:
+    """Differentiate a velocity trace [m/s] to acceleration [m/s^2] in place, if asked to."""
+    if not differentiate:
+        raise UnitsError(
+            name,
+            f"channel {trace.id} is a velocity record ({what}); pass differentiate=True"
+            " (command line: --differentiate) to differentiate it to acceleration",
+        )
+    # Central differences inside, one-sided at the ends (obspy's Trace.differentiate).
+    trace.data = np.gradient(np.asarray(trace.data, dtype=np.float64), trace.stats.delta)
+    return how + "; velocity differentiated to acceleration (central differences)"
+
+
+def _by_sensitivity(trace, response, source_label, differentiate, name, note=""):
+    """Divide counts by a response's overall sensitivity; convert its input unit to SI."""
+    sensitivity = response.instrument_sensitivity if response is not None else None
+    value = None if sensitivity is None else sensitivity.value
+    if value is None or not (math.isfinite(value) and value > 0):
+        raise RecordError(
+            name, f"{source_label} has no usable sensitivity for channel {trace.id}"
+            f" (value {value!r}; a positive finite number of counts per input unit is needed)"
+        )
+    input_units = sensitivity.input_units or ""
+    quantity, factor = _input_unit(input_units)
+    if quantity is None:
+        raise UnitsError(
+            name, f"{source_label}: channel {trace.id} senses {input_units or 'unknown units'},"
+            " which is neither an acceleration nor a velocity; use response='full'"
+            " (command line: --response full)",
+        )
+    trace.data = np.asarray(trace.data, dtype=np.float64) * (factor / value)
+    how = (f"counts -> {'m/s**2' if quantity == 'acceleration' else 'm/s'} by the overall"
+           f" sensitivity {value:.6g} counts/({input_units}) of {source_label}{note}")
+    if quantity == "velocity":
+        how = _differentiate(trace, how, differentiate, name, f"{source_label} senses {input_units}")
+    return how
+
+
+def _by_response(trace, inventory, inventory_name, response, differentiate) -> str:
+    """Counts to m/s^2 with an inventory, or with the response attached to the trace."""
+    name = _source(trace)
+    if inventory is not None:
+        channel = _select_channel(trace, inventory, inventory_name)
+        resp, label = channel.response, f"StationXML {inventory_name}"
+    else:
+        resp, label = trace.stats.response, "the response attached to the stream"
+    if response == "sensitivity":
+        return _by_sensitivity(trace, resp, label, differentiate, name)
+    if response != "full":
+        raise ParameterError(f"response must be 'sensitivity' or 'full', not {response!r}")
+    if resp is None or not resp.response_stages:
+        # Strong-motion StationXML often holds the overall sensitivity only: with no stages there
+        # is no frequency response to remove, and the sensitivity is all there is.
+        return _by_sensitivity(
+            trace, resp, label, differentiate, name,
+            note=" (response='full' asked, but the response has no stages)",
+        )
+    trace.data = np.asarray(trace.data, dtype=np.float64)
+    try:
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="Found more than one matching")
+            if inventory is not None:
+                # The channel of the record's epoch, not whichever epoch obspy finds first.
+                trace.stats.response = resp
+            trace.remove_response(output="ACC")
+    except Exception as exc:  # noqa: BLE001 - obspy raises many kinds on bad responses
+        raise RecordError(name, f"response of {trace.id} from {label} failed: {exc}") from exc
+    return f"counts -> m/s**2 by the full response of {label} (obspy remove_response, output ACC)"
+
+
+def _sac_unit(trace: Trace) -> tuple[str | None, str]:
+    """The unit a SAC file states (KUSER0-2 unit word, else IDEP), and where it came from."""
+    sac = trace.stats.get("sac") or {}
+    for key in ("kuser0", "kuser1", "kuser2"):
+        word = str(sac.get(key, "") or "").strip()
+        if word and word != "-12345" and (canonical_unit(word) or _velocity_unit(word)):
+            return word, f"SAC {key.upper()}={word!r}"
+    idep = sac.get("idep")
+    if idep in SAC_IDEP_UNITS:
+        return SAC_IDEP_UNITS[idep], f"SAC IDEP={idep} ({SAC_IDEP_NAMES[idep]})"
+    return None, ""
+
+
+def _velocity_unit(unit: str | None) -> str | None:
+    key = (unit or "").strip().lower().replace(" ", "").replace("sec", "s")
+    return key if key in VELOCITY_UNITS_TO_SI else None
+
+
+def _check_gravity(trace: Trace, unit: str, origin: str, name: str) -> None:
+    """Refuse a vertical whose mean is 1 in a unit where 1 g would be absurdly small."""
+    letter = _orientation_letter(trace.stats.channel)
+    if letter != "Z" or unit != "nm/s^2":
+        return
+    mean = float(np.mean(np.asarray(trace.data, dtype=np.float64)))
+    if abs(abs(mean) - 1.0) <= GRAVITY_MEAN_TOLERANCE:
+        raise UnitsError(
+            name,
+            f"{origin} says the samples are in nm/s^2, but vertical channel {trace.id} averages"
+            f" {mean:.4g}: that is gravity in g, not 1 nm/s^2 (Community Seismic Network files"
+            " are written so); give units='g' (command line: --units g)",
+        )
+
+
+def _to_si(trace: Trace, inventory, inventory_name, units, response, differentiate=False) -> str:
     """Convert one trace to m/s^2 in place; return how it was done."""
     name = _source(trace)
     stats = trace.stats
@@ -290,53 +426,22 @@ def _to_si(trace: Trace, inventory, inventory_name, units, response) -> str:
         if units is not None and si_factor(units, name) != si_factor(original, name):
             raise UnitsError(name, f"units={units!r} contradicts the file's own unit {original!r}")
         return f"{original} -> m/s**2 from the file header ({fmt or 'stream'})"
+    if current == "m/s" and units is None:
+        how = f"{stats.get('original_units', 'm/s')} -> m/s from the file header ({fmt})"
+        how = _differentiate(trace, how, differentiate, name, "the file states velocity")
+        stats.units = _SI_UNITS
+        return how
     if current not in (None, "counts"):
         raise UnitsError(name, f"channel {trace.id} has unsupported units {current!r}")
 
-    if inventory is not None and fmt not in CALIB_IN_SI_FORMATS:
-        if units is not None:
-            raise UnitsError(
-                name, "both an inventory and units= were given for raw data; give one of them"
-            )
-        channel = _select_channel(trace, inventory, inventory_name)
-        sensitivity = channel.response.instrument_sensitivity if channel.response else None
-        if sensitivity is None or not sensitivity.value:
-            raise RecordError(
-                name, f"StationXML {inventory_name} has no sensitivity for channel {trace.id}"
-            )
-        input_units = (sensitivity.input_units or "").upper()
-        trace.data = np.asarray(trace.data, dtype=np.float64)
-        with warnings.catch_warnings():
-            warnings.filterwarnings("ignore", message="Found more than one matching")
-            try:
-                if response == "sensitivity":
-                    if input_units not in _ACCELERATION_INPUT_UNITS:
-                        raise UnitsError(
-                            name,
-                            f"StationXML {inventory_name}: channel {trace.id} senses"
-                            f" {input_units or 'unknown units'}, not acceleration; use"
-                            " response='full' to convert to acceleration",
-                        )
-                    trace.remove_sensitivity(inventory)
-                    how = (
-                        f"counts -> m/s**2 by the overall sensitivity"
-                        f" {sensitivity.value:.6g} counts/({input_units}) of {inventory_name}"
-                    )
-                elif response == "full":
-                    trace.remove_response(inventory=inventory, output="ACC")
-                    how = f"counts -> m/s**2 by the full response of {inventory_name}"
-                else:
-                    raise ParameterError(f"response must be 'sensitivity' or 'full', not {response!r}")
-            except (ShipblockError, ValueError) as exc:
-                if isinstance(exc, ShipblockError) or "response must be" in str(exc):
-                    raise
-                raise RecordError(
-                    name, f"response of {trace.id} from {inventory_name} failed: {exc}"
-                ) from exc
-            except Exception as exc:  # noqa: BLE001
-                raise RecordError(
-                    name, f"response of {trace.id} from {inventory_name} failed: {exc}"
-                ) from exc
+    has_response = inventory is not None or stats.get("response") is not None
+    if has_response and fmt not in CALIB_IN_SI_FORMATS and units is None:
+        how = _by_response(trace, inventory, inventory_name, response, differentiate)
+        original = "counts"
+    elif has_response and inventory is not None and units is not None:
+        raise UnitsError(
+            name, "both an inventory and units= were given for raw data; give one of them"
+        )
     elif fmt in CALIB_IN_SI_FORMATS:
         if units is not None:
             raise UnitsError(
@@ -345,24 +450,41 @@ def _to_si(trace: Trace, inventory, inventory_name, units, response) -> str:
         trace.data = np.asarray(trace.data, dtype=np.float64) * stats.calib
         how = f"counts -> m/s**2 by stats.calib={stats.calib:.6g} ({CALIB_IN_SI_FORMATS[fmt]})"
         stats.calib = 1.0
-    elif units is not None:
-        factor = si_factor(units, name)
+        original = "counts"
+    else:
+        origin = "the caller's units="
+        if units is None and fmt == "SAC":
+            units, origin = _sac_unit(trace)
+            if units is not None:
+                _check_gravity(trace, units, origin, name)
+        if units is None:
+            raise UnitsError(
+                name,
+                f"units of channel {trace.id} are unknown ({fmt or 'stream'} data"
+                f"{', raw counts' if current == 'counts' else ''}): give inventory= (StationXML;"
+                " command line: --inventory FILE) for raw counts, or units= ('m/s^2', 'cm/s^2',"
+                " 'gal', 'g', or a velocity unit 'm/s', 'cm/s' with differentiate=True; command"
+                " line: --units)",
+            )
         data = np.asarray(trace.data, dtype=np.float64)
-        how = f"{units} -> m/s**2 as stated by the caller (x{factor:g})"
+        prefix = ""
         if stats.calib != 1.0:
             data = data * stats.calib
-            how = f"calib {stats.calib:g} from the {fmt or 'stream'} header, then " + how
+            prefix = f"calib {stats.calib:g} from the {fmt or 'stream'} header, then "
             stats.calib = 1.0
-        trace.data = data * factor
-    else:
-        raise UnitsError(
-            name,
-            f"units of channel {trace.id} are unknown ({fmt or 'stream'} data"
-            f"{', raw counts' if current == 'counts' else ''}): give inventory= (StationXML) for"
-            " raw counts, or units= ('m/s^2', 'cm/s^2', 'gal', 'g')",
-        )
+        velocity = _velocity_unit(units)
+        if velocity is not None:
+            factor = VELOCITY_UNITS_TO_SI[velocity]
+            trace.data = data * factor
+            how = prefix + f"{units} -> m/s as stated by {origin} (x{factor:g})"
+            how = _differentiate(trace, how, differentiate, name, f"{origin} gives {units}")
+        else:
+            factor = si_factor(units, name)
+            trace.data = data * factor
+            how = prefix + f"{units} -> m/s**2 as stated by {origin} (x{factor:g})"
+        original = units
     stats.units = _SI_UNITS
-    stats.original_units = stats.get("original_units", "counts" if inventory else units)
+    stats.original_units = stats.get("original_units", original)
     return how
 
 
@@ -422,6 +544,44 @@ def _orientation(trace: Trace, inventory):
             azimuth = {"N": 0.0, "E": 90.0}.get(letter)
         return "H", azimuth, 0.0, note
     return None, azimuth, dip, note
+
+
+def sensor_code(trace: Trace) -> str:
+    """``"<location>.<band+instrument>"`` of a trace, e.g. ``"02.HN"``: one sensor of a station.
+
+    Only SEED channel codes (three characters, band and instrument letters first) name a sensor;
+    other codes (an AT2 file's ``"180"``, an EVT file's ``"0"``) leave it empty.
+    """
+    channel = trace.stats.channel
+    code = channel[:2] if len(channel) == 3 and channel[:2].isalpha() else ""
+    return f"{trace.stats.location}.{code}"
+
+
+def _select_sensor(stream: Stream, sensor: str | None, channel_map) -> Stream:
+    """Keep the traces of one sensor; refuse a choice between several that nobody made."""
+    sensors = dict.fromkeys(sensor_code(tr) for tr in stream)
+    if sensor is None:
+        if len(sensors) <= 1 or channel_map:
+            return stream
+        stations = {(tr.stats.network, tr.stats.station) for tr in stream}
+        if len(stations) > 1:
+            return stream  # several stations: _assign_components says so
+        label = _source(stream[0])
+        raise RecordError(
+            label,
+            "the files hold several sensors of one station: "
+            + ", ".join(f"{code} ({', '.join(tr.stats.channel for tr in stream if sensor_code(tr) == code)})"
+                        for code in sensors)
+            + "; choose one with sensor='<location>.<code>' (command line: --sensor)",
+        )
+    wanted = sensor.strip().upper()
+    chosen = Stream([tr for tr in stream if sensor_code(tr).upper() == wanted
+                     or ("." not in wanted and tr.stats.channel[:2].upper() == wanted)])
+    if not chosen:
+        raise ParameterError(
+            f"sensor={sensor!r} matches none of the record's sensors: {', '.join(sensors)}"
+        )
+    return chosen
 
 
 def _match_map(trace: Trace, channel_map: Mapping[str, str]):
@@ -493,6 +653,11 @@ def _assign_components(
         if verticals:
             assigned["V"] = verticals[0]
     if "H1" not in assigned and "H2" not in assigned:
+        if "V" in assigned:
+            raise RecordError(
+                label, f"holds only a vertical component ({assigned['V'].id}); the model needs a"
+                " horizontal one"
+            )
         raise RecordError(label, "no horizontal component found")
     for component, trace in assigned.items():
         kind, azimuth, dip, _ = info[id(trace)]
@@ -878,6 +1043,41 @@ class GroundMotion:
 # --------------------------------------------------------------------------------------------
 
 
+def _names_many(source) -> bool:
+    """Whether a source is a folder or a glob pattern (rather than files or traces)."""
+    import glob as globbing
+
+    if not isinstance(source, (str, os.PathLike)):
+        return False
+    name = os.fspath(source)
+    return os.path.isdir(name) or (not os.path.exists(name) and globbing.has_magic(name))
+
+
+def _one_of_folder(source, inventory, units, response, differentiate, align, gaps, event,
+                   azimuth, horizontal) -> GroundMotion:
+    """The single record of a folder or glob; refuse a folder of several."""
+    from shipblock.collection import read_motions
+
+    found = read_motions(source, inventory=inventory, units=units, response=response,
+                         differentiate=differentiate, align=align, gaps=gaps, event=event)
+    label = os.fspath(source)
+    if len(found) != 1:
+        failures = "".join(f"\n  {where}: {why}" for where, why in found.failures)
+        raise RecordError(
+            label,
+            f"holds {len(found)} records ("
+            + ", ".join(m.name for m in found.motions)
+            + "); read_motions() returns them all, or name the files of one" + failures,
+        )
+    motion = found.motions[0]
+    if azimuth is not None or horizontal is not None:
+        metadata = dict(motion.metadata)
+        metadata["horizontal"] = (f"projected on azimuth {azimuth:g} deg" if azimuth is not None
+                                  else horizontal)
+        motion = GroundMotion(motion.stream, metadata, azimuth=azimuth, horizontal=horizontal)
+    return motion
+
+
 def read_motion(
     paths_or_stream,
     inventory=None,
@@ -891,6 +1091,8 @@ def read_motion(
     gaps: str = "refuse",
     align: str = "trim",
     format: str | None = None,
+    differentiate: bool = False,
+    sensor: str | None = None,
     **read_kwargs,
 ) -> GroundMotion:
     """Read record files (or a Stream) into a :class:`GroundMotion` in m/s^2.
@@ -898,19 +1100,25 @@ def read_motion(
     Parameters
     ----------
     paths_or_stream : str, os.PathLike, list of them, obspy.Stream or obspy.Trace
-        One file with all components, several one-component files, or traces in memory.
+        One file with all components, several one-component files, traces in memory, or a
+        folder or glob pattern holding exactly one record (use
+        :func:`shipblock.collection.read_motions` for a folder of many).
     inventory : str, os.PathLike or obspy.Inventory, optional
         StationXML for raw counts (and channel azimuths/dips).
     units : str, optional
-        Unit of records that do not carry one: ``"m/s^2"``, ``"cm/s^2"``, ``"gal"``, ``"g"``.
+        Unit of records that do not carry one: ``"m/s^2"``, ``"cm/s^2"``, ``"gal"``, ``"g"``, or a
+        velocity unit (``"m/s"``, ``"cm/s"``, with ``differentiate=True``).
     azimuth : float, optional
         Azimuth of the dock's transverse axis (the 2-D model's plane) [deg clockwise from north];
         the two horizontals are projected on it.
     horizontal : {"H1", "H2"}, optional
         Use this horizontal as-is instead of rotating.
     response : {"sensitivity", "full"}, optional
-        With an inventory: divide by the overall sensitivity (default), or remove the full
-        response to acceleration (:meth:`obspy.core.trace.Trace.remove_response`, no pre-filter).
+        With an inventory (or a response attached to a Stream's traces as ``stats.response``):
+        divide by the overall sensitivity of the channel's epoch at the record's start (default;
+        the only choice for StationXML that holds a sensitivity and no stages), or remove the
+        full response to acceleration (:meth:`obspy.core.trace.Trace.remove_response`, no
+        pre-filter; falls back to the sensitivity, and says so, when there are no stages).
     channel_map : dict, optional
         ``{channel code, SEED id or file name: "H1" | "H2" | "V"}`` when the files do not tell
         the components; unmapped traces are left out.
@@ -923,6 +1131,13 @@ def read_motion(
         trims them to their common time window; ``"strict"`` refuses any mismatch.
     format : str, optional
         obspy format name for all files (auto-detected when omitted).
+    differentiate : bool, optional
+        Differentiate velocity records (a velocity sensor's sensitivity, a velocity unit given or
+        stated by the file) to acceleration; without it they are refused. Said in the provenance.
+    sensor : str, optional
+        Which sensor of a station to use when the files hold several: the first two letters of the
+        channel code (``"HN"``), optionally after the location (``"02.HN"``; K-NET/KiK-net:
+        ``"01"`` is the borehole, ``"02"`` the surface sensor).
     **read_kwargs
         Passed to the file reader (e.g. ``dt`` [s] for one-column text files).
 
@@ -943,6 +1158,9 @@ def read_motion(
         raise ParameterError("give azimuth= or horizontal=, not both")
     if align not in ("trim", "strict"):
         raise ParameterError(f"align must be 'trim' or 'strict', not {align!r}")
+    if _names_many(paths_or_stream):
+        return _one_of_folder(paths_or_stream, inventory, units, response, differentiate, align,
+                              gaps, event, azimuth, horizontal)
     stream = _load_stream(paths_or_stream, units, format, read_kwargs)
     label = ", ".join(dict.fromkeys(_source(tr) for tr in stream)) or "<stream>"
     if len(stream) == 0:
@@ -950,6 +1168,7 @@ def read_motion(
     for trace in stream:
         _check_finite(trace)
     stream = _merge_gaps(stream, gaps)
+    stream = _select_sensor(stream, sensor, channel_map)
     inv, inventory_name = _load_inventory(inventory)
     notes: list[str] = []
     processing: list[str] = []
@@ -960,8 +1179,18 @@ def read_motion(
     for component, trace in assigned.items():
         with warnings.catch_warnings():
             warnings.filterwarnings("ignore", message="Found more than one matching")
-            units_done[component] = _to_si(trace, inv, inventory_name, units, response)
+            units_done[component] = _to_si(
+                trace, inv, inventory_name, units, response, differentiate
+            )
         _check_finite(trace)
+    if "V" in assigned:
+        mean = float(np.mean(assigned["V"].data))
+        if abs(mean) > GRAVITY_NOTE_THRESHOLD:
+            notes.append(
+                f"V ({assigned['V'].id}) averages {mean:.4g} m/s^2: gravity or an offset in the"
+                " record; remove it (baseline correction) before simulating"
+            )
+            logger.warning("%s: %s", label, notes[-1])
     traces = [assigned[c] for c in COMPONENTS if c in assigned]
     _align(traces, align, processing)
     result = Stream(traces)

@@ -28,6 +28,8 @@ ACCELERATION_UNITS_TO_SI: dict[str, float] = {
     "gal": 0.01,
     "mm/s^2": 0.001,
     "mm/s**2": 0.001,
+    "nm/s^2": 1e-9,
+    "nm/s**2": 1e-9,
     "in/s^2": INCH,
     "in/s**2": INCH,
     "g": STANDARD_GRAVITY,
@@ -39,6 +41,7 @@ VELOCITY_UNITS_TO_SI: dict[str, float] = {
     "m/s": 1.0,
     "cm/s": 0.01,
     "mm/s": 0.001,
+    "nm/s": 1e-9,
     "in/s": INCH,
 }
 

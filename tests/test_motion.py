@@ -256,7 +256,7 @@ def test_bad_traces(tmp_path):
         read_motion(Stream([_trace([], "HNN")]), units="g")
     with pytest.raises(RecordError, match="NaN/inf"):
         read_motion(Stream([_trace([1.0, np.inf], "HNN")]), units="g")
-    with pytest.raises(RecordError, match="no horizontal"):
+    with pytest.raises(RecordError, match="only a vertical component"):
         read_motion(Stream([_trace([1.0, 2.0], "HNZ")]), units="g")
     only_h1 = read_motion(Stream([_trace([1.0, 2.0], "HNN")]), units="g")
     assert only_h1.vertical is None and "V" not in only_h1.components

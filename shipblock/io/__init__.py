@@ -28,6 +28,7 @@ import obspy
 from shipblock.errors import RecordError, ShipblockError
 from shipblock.io import at2, cosmos, esm, text
 from shipblock.io._common import peek_text
+from shipblock.io.knet import normalise_knet
 
 __all__ = ["FORMATS", "read_record"]
 
@@ -115,6 +116,10 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
         warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
     if len(stream) == 0:
         raise RecordError(name, "holds no traces")
+    empty = [tr.id for tr in stream if tr.stats.npts == 0 or len(tr.data) == 0]
+    if empty:
+        raise RecordError(name, f"channel {empty[0]} has no samples (corrupt or truncated file?)")
+    normalise_knet(stream)
     for trace in stream:
         trace.stats.source_file = name
     return stream

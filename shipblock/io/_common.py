@@ -55,6 +55,11 @@ UNIT_ALIASES: dict[str, str] = {
     "mm/s^2": "mm/s^2",
     "mm/s**2": "mm/s^2",
     "mm/s/s": "mm/s^2",
+    "mm/s2": "mm/s^2",
+    "nm/s^2": "nm/s^2",
+    "nm/s**2": "nm/s^2",
+    "nm/s/s": "nm/s^2",
+    "nm/s2": "nm/s^2",
 }
 
 

@@ -1,0 +1,212 @@
+"""Folders of record files: grouped into ground motions, with every unreadable file named.
+
+An agency download is a folder (or a glob) of files: one file per component (K-NET, MiniSEED,
+SAC, ESM), three components per file (CSMIP, GeoNet, COSMOS), StationXML inventories and an
+event file beside them. :func:`read_motions` reads every file it can, groups the traces into
+one record per station sensor, converts each with :func:`shipblock.motion.read_motion`, and
+returns the records together with the list of files and groups that could not be used and why.
+One bad file never costs the others.
+
+Grouping key of a trace: network, station, location, the first two letters of the channel
+(band and instrument: one sensor; K-NET/KiK-net borehole and surface sensors have locations
+``01``/``02``), the format, and, for formats whose files are processing volumes (CSMIP ``.V1``
+and ``.V2``, GeoNet ``.V1A`` and ``.V2A``, ...), the file's extension, so that a station's
+uncorrected and corrected volumes are two records, not one with six components.
+"""
+
+from __future__ import annotations
+
+import glob as globbing
+import logging
+import os
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import obspy
+from obspy import Stream
+
+from shipblock.errors import RecordError, ShipblockError
+from shipblock.io import read_record
+from shipblock.motion import GroundMotion, read_motion, sensor_code
+
+__all__ = ["MotionSet", "expand_sources", "read_motions"]
+
+logger = logging.getLogger(__name__)
+
+#: Extensions of files in agency folders that are never waveforms (lower case).
+NOT_WAVEFORMS = {".json", ".yml", ".yaml", ".md", ".toml", ".zip", ".png", ".jpg", ".pdf",
+                 ".html", ".py", ".pkl", ".xlsx", ".hdf", ".h5", ".grd", ".gz"}
+
+#: Formats whose components come one per file, named by the file's extension (the extension is
+#: then not a processing volume and does not enter the grouping key).
+_COMPONENT_PER_EXTENSION = {"KNET", "MSEED", "SAC", "SHIPBLOCK_ESM", "SHIPBLOCK_AT2"}
+
+
+@dataclass
+class MotionSet:
+    """The records read from a folder or glob, and what could not be read.
+
+    Attributes
+    ----------
+    motions : list of GroundMotion
+        One per station sensor (and processing volume), in file order.
+    failures : list of (str, str)
+        ``(file or record, reason)`` for every file that could not be read and every group of
+        traces that did not make a ground motion.
+    skipped : list of str
+        Files that are not waveforms (by extension) or were used as inventory/event files.
+    """
+
+    motions: list[GroundMotion] = field(default_factory=list)
+    failures: list[tuple[str, str]] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+
+    def __iter__(self):
+        return iter(self.motions)
+
+    def __len__(self) -> int:
+        return len(self.motions)
+
+    def __getitem__(self, index):
+        return self.motions[index]
+
+
+def expand_sources(source) -> list[Path]:
+    """Files named by a folder (recursively), a glob pattern, a file, or a list of them.
+
+    Raises
+    ------
+    RecordError
+        If a named file or folder does not exist, or a pattern matches nothing.
+    """
+    if isinstance(source, (list, tuple)):
+        return [path for item in source for path in expand_sources(item)]
+    name = os.fspath(source)
+    if os.path.isdir(name):
+        return sorted(p for p in Path(name).rglob("*") if p.is_file() and not p.name.startswith("."))
+    if os.path.isfile(name):
+        return [Path(name)]
+    if globbing.has_magic(name):
+        matches = sorted(Path(p) for p in globbing.glob(name, recursive=True) if os.path.isfile(p))
+        if not matches:
+            raise RecordError(name, "the pattern matches no file")
+        return matches
+    raise RecordError(name, "no such file or folder")
+
+
+def _xml_kind(path: Path) -> str | None:
+    """``"stationxml"``, ``"quakeml"`` or ``None`` from the first bytes of an XML file."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+    except OSError:
+        return None
+    if b"FDSNStationXML" in head:
+        return "stationxml"
+    if b"quakeml" in head.lower():
+        return "quakeml"
+    return None
+
+
+def _group_key(trace) -> tuple:
+    stats = trace.stats
+    fmt = stats.get("_format", "")
+    source = str(stats.get("source_file", ""))
+    volume = "" if fmt in _COMPONENT_PER_EXTENSION else Path(source).suffix.upper()
+    if not (stats.network or stats.station):
+        return ("", source, "", "", fmt, volume)  # no codes: a file is a record of its own
+    return (stats.network, stats.station, stats.location, sensor_code(trace).split(".", 1)[1],
+            fmt, volume)
+
+
+def _label(key: tuple) -> str:
+    network, station, location, sensor, fmt, volume = key
+    if not (network or station):
+        return station or location or "?"
+    return f"{network}.{station}.{location}.{sensor}{volume and ' ' + volume}"
+
+
+def read_motions(source, inventory=None, units: str | None = None, *,
+                 response: str = "sensitivity", differentiate: bool = False,
+                 align: str = "trim", gaps: str = "refuse", event=None) -> MotionSet:
+    """Read a folder, glob or list of record files into one ground motion per station sensor.
+
+    Parameters
+    ----------
+    source : str, os.PathLike or list of them
+        A folder (read recursively), a glob pattern (``"records/*.V2"``) or files.
+    inventory : str, os.PathLike or obspy.Inventory, optional
+        StationXML for raw counts. Default: every StationXML file among the sources, merged.
+    units : str, optional
+        Unit of records that state none (see :func:`shipblock.motion.read_motion`).
+    response, differentiate, align, gaps
+        As in :func:`shipblock.motion.read_motion`.
+    event : optional
+        QuakeML file or object; default: a QuakeML file among the sources, if there is one.
+
+    Returns
+    -------
+    MotionSet
+        The ground motions, and the files and groups that failed with their reasons.
+
+    Raises
+    ------
+    RecordError
+        If the source names nothing; a folder in which no file is readable gives an empty set
+        with every failure listed, not an error.
+    """
+    result = MotionSet()
+    paths = expand_sources(source)
+    inventories, events, waveforms = [], [], []
+    for path in paths:
+        suffix = path.suffix.lower()
+        if suffix == ".xml":
+            kind = _xml_kind(path)
+            if kind == "stationxml":
+                inventories.append(path)
+            elif kind == "quakeml":
+                events.append(path)
+            result.skipped.append(str(path))
+        elif suffix in NOT_WAVEFORMS:
+            result.skipped.append(str(path))
+        else:
+            waveforms.append(path)
+    if inventory is None and inventories:
+        inventory = obspy.Inventory()
+        for path in inventories:
+            try:
+                inventory += obspy.read_inventory(str(path))
+            except Exception as exc:  # noqa: BLE001 - a bad inventory is one failure, not all
+                result.failures.append((str(path), f"cannot be read as StationXML: {exc}"))
+    if event is None and len(events) == 1:
+        event = str(events[0])
+
+    groups: dict[tuple, Stream] = {}
+    for path in waveforms:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                stream = read_record(path, units=units)
+        except ShipblockError as exc:
+            result.failures.append((str(path), getattr(exc, "problem", str(exc))))
+            continue
+        for trace in stream:
+            groups.setdefault(_group_key(trace), Stream()).append(trace)
+
+    for key, stream in groups.items():
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                motion = read_motion(
+                    stream, inventory=inventory, units=units, response=response,
+                    differentiate=differentiate, align=align, gaps=gaps, event=event,
+                )
+        except ShipblockError as exc:
+            files = ", ".join(dict.fromkeys(str(tr.stats.get("source_file", "")) for tr in stream))
+            result.failures.append((f"{_label(key)} ({files})", getattr(exc, "problem", str(exc))))
+            continue
+        result.motions.append(motion)
+    logger.info("%d records read from %d files; %d failures", len(result.motions), len(paths),
+                len(result.failures))
+    return result
