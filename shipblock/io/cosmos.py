@@ -1,39 +1,74 @@
-"""Reader for COSMOS V1/V2 strong-motion text files (obspy waveform plug-in ``SHIPBLOCK_COSMOS``).
+"""Reader for COSMOS V0/V1/V2 strong-motion text files (obspy plug-in ``SHIPBLOCK_COSMOS``).
 
 Written from the COSMOS Strong Motion Data Format, version 1.20 (2001) [1]_, the format CSMIP/CESMD
-and the USGS NSMP distribute their V1 (uncorrected) and V2 (corrected) records in. A file holds one
-or more channel blocks; each block has
+and the USGS NSMP distribute their V0 (raw counts), V1 (uncorrected) and V2 (corrected) records in.
+A file holds one or more channel blocks; each block has
 
-* a text header (the first line says ``(Format v01.20 with 13 text lines)``; line 5 holds
-  ``Code:<network>-<station>``; line 13 the values used for unknown parameters);
+* a text header (the first line names the data, e.g. ``Corrected acceleration``, and says
+  ``(Format v01.20 with 13 text lines)``; line 5 holds ``Code:<network>-<station>``; line 8 the
+  record start time; line 11 the peak; line 13 the values used for unknown parameters);
 * ``N Integer-header values follow on M lines, Format= (10I8)`` and the integers;
 * ``N Real-header values follow on M lines, Format= (6E13.6)`` and the reals;
 * ``N Comment line(s) follow, each starting with a "|":`` and the comments;
 * one data section per quantity, each introduced by a line such as
-  ``8000 acceleration pts, approx 40 secs, units=cm/sec2 (04), Format=(8F10.5)``: V1 files have
+  ``8000 acceleration pts, approx 40 secs, units=cm/sec2 (04), Format=(8F10.5)``: V0/V1 files have
   acceleration only, V2 files acceleration, velocity and displacement;
-* an ``End-of-data for Chan 1 ...`` line.
+* an end-of-data line.
 
 Header entries used (1-based, as numbered in the specification): Int(1) processing stage, Int(2)
 kind of quantity (1 = acceleration), Int(3) physical-units code (Table 2), Int(40), Int(42)-Int(45)
 start year, month, day, hour, minute, Int(54) sensor orientation (0-360 deg azimuth, 400 up, 401
 down, 402 vertical of unknown sense, 500/501 radial/transverse, 600/601 longitudinal/tangential,
-700/701 horizontal of unknown azimuth), Int(55) orientation relative to the structure (used only
-to tell vertical from horizontal when Int(54) is unknown), Real(1)-Real(3) station latitude,
-longitude [deg] and elevation [m], Real(30) start second [s], Real(62) sampling interval [ms].
+700/701 horizontal of unknown azimuth, 2000 other), Int(55) orientation relative to the structure
+(used only to tell vertical from horizontal when Int(54) is unknown), Real(1)-Real(3) station
+latitude, longitude [deg] and elevation [m], Real(30) start second [s], Real(62) sampling interval
+[ms], Real(63) record length [s], Real(64)/Real(65) the peak of the data (file units, signed) and
+its time [s].
+
+What the real files (USGS NSMP, AK via USGS, and the CESMD-style test files of the gmprocess
+corpus) showed beyond the specification:
+
+* **End-of-data lines** are written as ``End-of-data for ChanHNE``, ``End-of-data for
+  1795.HNE.NP.-- acceleration`` or ``/&  ----------  End of data for channel  1  ----------``
+  (all three are accepted; a block without one, or anything else between blocks, is an error:
+  it is how a file cut at a line boundary shows).
+* **Fixed-width samples run together**: ``(10I8)`` counts such as ``-1341626-1341627`` have no
+  blank between them, so the data are cut by the format's field width, not split on blanks. A
+  data line must end on a field boundary: a file cut inside the last field (``-2378631`` cut to
+  ``-237863``) would otherwise still parse.
+* **Unknown values** (``-999``) where readers expect a value: Int(1) (processing stage) and Int(2)
+  unknown in a CESMD-style file whose line 1 says ``Corrected acceleration`` and whose data line
+  says ``acceleration pts, units=cm/sec2(04)``. Neither is needed to read the samples: the stage is
+  then taken from line 1 (``Raw acceleration counts`` 0, ``Uncorrected`` 1, ``Corrected`` 2) and
+  noted. Real(30) (start second) unknown: the start time is taken from text line 8
+  (``Rcrd start time:06/16/2005, 20:53:04.400 UTC``, printed to 1 ms); with neither, the start
+  time is left unset rather than rounded to the minute. Line 13 may list no null values at all
+  (the specification's ``-999`` is then used).
+* **Station code with no network**: ``Code:---J2236`` (network ``--``, i.e. unknown).
+* **Self-contradicting orientation**: the USGS copy of AK.BMR ``BNZ`` (2018 Anchorage) has
+  Int(54)=0 (north) on a channel that the ``|<SCNL>BMR.BNZ.AK.--`` comment, the RcrdId and the file
+  name call vertical and whose text line 9 says "Other". When the SCNL channel's orientation (Z vs
+  horizontal, or N vs E) contradicts Int(54), the reader warns and keeps the channel code, dropping
+  the Int(54) azimuth/dip, so a vertical record is never silently taken as a horizontal one.
+* **Structure arrays** (NP.8040, R B Atwood building) leave Int(54) unknown and give the
+  orientation relative to the structure in Int(55) (400 = up, 90 = a horizontal): enough to tell
+  vertical from horizontal, not a geographic azimuth.
+* **Self-contradicting units**: a data line ``units=cm/sec2(04)`` under Int(3)=25 (degrees) is
+  refused (:class:`~shipblock.errors.UnitsError` naming the channel block), since either could be
+  the wrong one.
 
 The channel and location codes come from a ``|<SCNL>STA.CHA.NET.LOC`` comment when the file has one
-(the USGS NSMP and CESMD write it; ``--`` is the empty location), else the channel is ``HN`` plus
-the orientation letter of Int(54). Real files can contradict themselves: the USGS copy of AK.BMR
-``BNZ`` (2018 Anchorage) has Int(54)=0 (north) on a vertical channel whose text header says
-"Other". When the SCNL channel's orientation (Z vs horizontal) contradicts Int(54), the reader
-warns and keeps the channel code, dropping the Int(54) azimuth/dip, so a vertical record is never
-silently taken as a horizontal one.
+(the USGS NSMP writes it; ``--`` is the empty location), else from
+:func:`~shipblock.io._common.orientation_stats` (``HNZ``, ``HNN``, ``HNE``, ``HN1``/``HN2`` for
+other or unknown azimuths, numbered in file order; ``HNX`` when nothing says whether the channel is
+vertical).
 
 Only the acceleration sections are read. Their unit code (from the data line, checked against
 Int(3)) is honoured: the samples are converted to m/s^2, ``stats.units`` is ``"m/s**2"`` and
 ``stats.original_units`` the file's unit. Raw counts (code 50, V0 files) are kept as counts with
-``stats.units == "counts"``, for conversion with a StationXML inventory.
+``stats.units == "counts"``, for conversion with a StationXML inventory. The stated peak
+Real(64) is kept in ``stats.shipblock_cosmos.stated_peak`` (file units) and, for accelerations,
+``stats.stated_peak_si`` (m/s^2, absolute value).
 
 References
 ----------
@@ -52,9 +87,12 @@ from obspy.core import AttribDict
 
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
+    CARDINAL_TOLERANCE_DEG,
+    band_code,
     check_delta,
     check_samples,
     make_trace,
+    orientation_stats,
     parse_float,
     peek_text,
     read_text,
@@ -66,8 +104,6 @@ __all__ = ["FORMAT", "UNIT_CODES", "is_cosmos", "read_cosmos"]
 
 #: Name under which the reader is registered as an obspy waveform plug-in.
 FORMAT = "SHIPBLOCK_COSMOS"
-
-#: The international inch [m] (exact), for the in/s^2 unit code.
 
 #: COSMOS Table 2 physical-unit codes of acceleration: code -> (name, factor to m/s^2).
 #: ``None`` marks raw counts, which need an instrument response.
@@ -81,11 +117,20 @@ UNIT_CODES: dict[int, tuple[str, float | None]] = {
     50: ("counts", None),
 }
 
-#: COSMOS unit codes of quantities that are not accelerations (velocity, displacement, ...).
-_NON_ACCELERATION_CODES = {1, 3, 5, 6, 8, 9, 22, 23, 24, 25, 51, 60, 80}
+#: COSMOS Table 2 codes of quantities that are not accelerations, named for error messages.
+_OTHER_UNIT_NAMES = {
+    1: "s", 3: "s and g", 5: "cm/s", 6: "cm", 8: "in/s", 9: "in", 22: "mV", 23: "deg/s^2",
+    24: "deg/s", 25: "deg", 51: "V", 60: "psi", 80: "micro-strain",
+}
 
 #: Value the specification uses for unknown parameters when the header does not say otherwise.
 DEFAULT_NULL = -999
+
+#: Precision of the start time printed on text line 8 [s] (milliseconds, rounded).
+TEXT_START_PRECISION_S = 0.5e-3
+
+#: Processing stage (Int(1)) named by the first words of text line 1, when Int(1) is unknown.
+_STAGE_WORDS = (("raw", 0), ("uncorrected", 1), ("corrected", 2))
 
 _FIRST_LINE = re.compile(r"\(\s*Format\s+v\s*[\d.]+", re.IGNORECASE)
 _TEXT_LINES = re.compile(r"with\s+(\d+)\s+text\s+lines", re.IGNORECASE)
@@ -105,12 +150,26 @@ _DATA_HEADER = re.compile(
     re.IGNORECASE,
 )
 _DATA_UNITS = re.compile(r"units\s*=\s*([^(,]*?)\s*\(\s*(\d+)\s*\)", re.IGNORECASE)
-_STATION_CODE = re.compile(r"Code\s*:\s*([A-Za-z0-9]{1,2})\s*-\s*([A-Za-z0-9]+)")
+#: ``Code:CE-J2236``; ``--`` (written ``---J2236``) is an unknown network.
+_STATION_CODE = re.compile(r"Code\s*:\s*([A-Za-z0-9]{1,2}|--)\s*-\s*([A-Za-z0-9]+)")
 #: USGS/CESMD comment naming the SEED channel: ``|<SCNL>8040.HNZ.NP.03`` (station.channel.net.loc).
 _SCNL = re.compile(
     r"<SCNL>\s*([A-Za-z0-9]+)\.([A-Za-z0-9]{3})\.([A-Za-z0-9]{1,2})\.([A-Za-z0-9]{2}|--)?"
 )
 _NULLS = re.compile(r"unknown.*?(-?\d+)\s*,\s*(-?\d+\.?\d*)", re.IGNORECASE)
+#: End of a channel block: ``End-of-data for ChanHNE`` or ``/&  ---  End of data for channel 1``.
+_END_OF_DATA = re.compile(r"^\s*(/&|end[\s-]*of[\s-]*data)", re.IGNORECASE)
+#: Text line 8: ``Rcrd start time: 2018/11/30 17:29:39.137 UTC`` or ``...:06/16/2005, 20:53:04.4``.
+_TEXT_START = re.compile(
+    r"start\s+time\s*:\s*(\d{1,4})[/-](\d{1,2})[/-](\d{1,4})\s*,?\s*"
+    r"(\d{1,2}):(\d{1,2}):(\d{1,2}(?:\.\d*)?)",
+    re.IGNORECASE,
+)
+#: Text line 11: ``Max =  -161.962 cm/sec2  at  27.850 sec`` or ``Max =   1033406 counts, at ...``.
+_TEXT_PEAK = re.compile(
+    r"Max\s*=\s*([-+]?(?:\d+\.?\d*|\.\d+))\s*([^\s,]*)\s*,?\s*at\s*([-+]?(?:\d+\.?\d*|\.\d+))",
+    re.IGNORECASE,
+)
 
 
 def is_cosmos(filename) -> bool:
@@ -135,10 +194,20 @@ def is_cosmos(filename) -> bool:
     return any(_INT_HEADER.match(line) for line in lines[1:60])
 
 
-def _fixed_width(lines, count: int, per_line: int, width: int, name: str, what: str):
-    """Parse ``count`` Fortran fixed-width numbers from ``lines``."""
+def _fixed_width(lines, count: int, per_line: int, width: int, name: str, what: str,
+                 aligned: bool = False):
+    """Parse ``count`` Fortran fixed-width numbers from ``lines``.
+
+    With ``aligned``, each line must end on a field boundary: Fortran right-justifies numbers,
+    so a line ending inside a field was cut (``-2378631`` cut to ``-237863`` is still a number).
+    """
     values = []
     for lineno, line in lines:
+        if aligned and len(line.rstrip()) % width:
+            raise RecordError(
+                name, f"line {lineno}: the {what} line ends inside a {width}-character field"
+                " (truncated or corrupt file)"
+            )
         for k in range(per_line):
             field = line[k * width : (k + 1) * width]
             if not field.strip():
@@ -149,6 +218,11 @@ def _fixed_width(lines, count: int, per_line: int, width: int, name: str, what: 
                 raise RecordError(
                     name, f"line {lineno}: {field.strip()!r} in the {what} is not a number"
                 ) from None
+        if len(line.rstrip()) > per_line * width:
+            raise RecordError(
+                name, f"line {lineno}: the {what} line is longer than its format"
+                f" ({per_line} fields of {width} characters)"
+            )
     if len(values) != count:
         raise RecordError(
             name, f"the {what} should hold {count} values but {len(values)} were found"
@@ -205,27 +279,31 @@ def _value(values, number: int, null: float):
     return value
 
 
-def _orientation(code, null_note: list) -> tuple[dict, str]:
-    """Map COSMOS Int(54) to ``azimuth``/``dip`` [deg] entries and a channel orientation letter."""
+def _orientation(code) -> dict | None:
+    """Interpret an Int(54)/Int(55) orientation code.
+
+    Returns ``None`` for an unknown or unrecognised code, else a dict with ``vertical`` (bool),
+    ``azimuth`` [deg] or ``None``, ``positive_up`` (bool), ``index`` (1/2 for the horizontals that
+    COSMOS numbers, else ``None``) and ``note`` (a caveat, or ``None``).
+    """
     if code is None:
-        return {}, "X"
+        return None
     code = int(code)
+    result = {"vertical": False, "azimuth": None, "positive_up": True, "index": None, "note": None}
     if 0 <= code <= 360:
-        azimuth = float(code % 360)
-        letter = {0.0: "N", 90.0: "E"}.get(azimuth, "H")
-        return {"azimuth": azimuth, "dip": 0.0}, letter
-    if code == 400:
-        return {"dip": -90.0}, "Z"
-    if code == 401:
-        return {"dip": 90.0}, "Z"
-    if code == 402:
-        null_note.append("vertical sense not indicated in the file (code 402); taken positive up")
-        return {"dip": -90.0}, "Z"
-    if code in (500, 600, 700):
-        return {"dip": 0.0}, "1"
-    if code in (501, 601, 701):
-        return {"dip": 0.0}, "2"
-    return {}, "X"
+        result["azimuth"] = float(code % 360)
+    elif code in (400, 401, 402):
+        result.update(vertical=True, positive_up=code != 401)
+        if code == 402:
+            result["note"] = ("vertical sense not indicated in the file (code 402); taken"
+                              " positive up")
+    elif code in (500, 600, 700):
+        result["index"] = 1
+    elif code in (501, 601, 701):
+        result["index"] = 2
+    else:
+        return None  # 2000 "other" and codes the specification does not define
+    return result
 
 
 def _scnl(comments) -> tuple[str, str, str, str] | None:
@@ -238,7 +316,14 @@ def _scnl(comments) -> tuple[str, str, str, str] | None:
     return None
 
 
-def _data_units(data_line: str, int_code, name: str) -> tuple[int, str]:
+def _unit_label(code: int) -> str:
+    """Name of a COSMOS Table 2 unit code, for messages."""
+    if code in UNIT_CODES:
+        return UNIT_CODES[code][0]
+    return _OTHER_UNIT_NAMES.get(code, "not in COSMOS Table 2")
+
+
+def _data_units(data_line: str, int_code, name: str, where: str) -> tuple[int, str]:
     """Return the unit code of a data section, cross-checked with Int(3)."""
     match = _DATA_UNITS.search(data_line)
     line_code = int(match.group(2)) if match else None
@@ -246,36 +331,76 @@ def _data_units(data_line: str, int_code, name: str) -> tuple[int, str]:
     if line_code is not None and int_code is not None and int(int_code) != line_code:
         raise UnitsError(
             name,
-            f"data line says unit code {line_code:02d} ({line_text}) but Int(3) says"
-            f" {int(int_code):02d}",
+            f"{where}: data line says unit code {line_code:02d} ({line_text}) but Int(3) says"
+            f" {int(int_code):02d} ({_unit_label(int(int_code))}); the units are contradictory",
         )
     code = line_code if line_code is not None else (None if int_code is None else int(int_code))
     if code is None:
-        raise UnitsError(name, "the acceleration data carry no unit code (data line nor Int(3))")
+        raise UnitsError(
+            name, f"{where}: the acceleration data carry no unit code (data line nor Int(3))"
+        )
     if code not in UNIT_CODES:
-        raise UnitsError(name, f"unit code {code:02d} ({line_text or '?'}) is not an acceleration")
+        raise UnitsError(
+            name, f"{where}: unit code {code:02d} ({line_text or _unit_label(code)}) is not an"
+            " acceleration"
+        )
     return code, line_text
 
 
-def _start_time(ints, reals, null) -> UTCDateTime | None:
-    """Return the record start time from Int(40), Int(42)-Int(45) and Real(30), if known."""
-    parts = [_value(ints, k, null) for k in (40, 42, 43, 44, 45)]
-    second = _value(reals, 30, null)
-    if any(p is None for p in parts):
+def _text_start(line: str) -> UTCDateTime | None:
+    """Parse the start time of text line 8 (``yyyy/mm/dd`` or ``mm/dd/yyyy``), or ``None``."""
+    match = _TEXT_START.search(line)
+    if match is None:
         return None
+    a, b, c, hour, minute, second = match.groups()
+    year, month, day = (a, b, c) if len(a) == 4 else (c, a, b)
     try:
-        year, month, day, hour, minute = (int(p) for p in parts)
-        return UTCDateTime(year, month, day, hour, minute) + (second or 0.0)
-    except Exception:  # noqa: BLE001 - an impossible date means "unknown"
+        return UTCDateTime(int(year), int(month), int(day), int(hour), int(minute)) + float(second)
+    except Exception:  # noqa: BLE001 - an impossible date means "not stated"
         return None
 
 
-def _read_block(cursor: _Lines, name: str, headonly: bool):
+def _start_time(ints, reals, null, text, notes) -> UTCDateTime | None:
+    """Record start from Int(40), Int(42)-Int(45) and Real(30), else from text line 8."""
+    line8 = _text_start(text[7]) if len(text) > 7 else None
+    parts = [_value(ints, k, null[0]) for k in (40, 42, 43, 44, 45)]
+    second = _value(reals, 30, null[1])
+    start = None
+    if all(p is not None for p in parts) and second is not None:
+        try:
+            year, month, day, hour, minute = (int(p) for p in parts)
+            start = UTCDateTime(year, month, day, hour, minute) + float(second)
+        except Exception:  # noqa: BLE001 - an impossible date means "unknown"
+            start = None
+    if start is None:
+        if line8 is not None:
+            notes.append("start time from text line 8 (integer/real header incomplete)")
+        return line8
+    if line8 is not None and abs(line8 - start) > TEXT_START_PRECISION_S + 1e-9:
+        notes.append(f"text line 8 start time {line8} differs from the header's {start}")
+    return start
+
+
+def _processing_stage(ints, null: int, first_line: str, notes) -> int | None:
+    """Int(1), or the stage named by text line 1 when Int(1) is unknown."""
+    stage = _value(ints, 1, null)
+    if stage is not None:
+        return int(stage)
+    words = first_line.split("(")[0].strip().lower()
+    for word, value in _STAGE_WORDS:
+        if words.startswith(word):
+            notes.append(f"Int(1) unknown; processing stage {value} from text line 1")
+            return value
+    return None
+
+
+def _read_block(cursor: _Lines, name: str, headonly: bool, horizontals: list):
     """Read one channel block; return its acceleration trace (or ``None``)."""
     first = cursor.peek()
+    block_line = cursor.index + 1
     if not _FIRST_LINE.search(first):
         raise RecordError(
-            name, f"line {cursor.index + 1}: expected a COSMOS text header, found {first[:60]!r}"
+            name, f"line {block_line}: expected a COSMOS text header, found {first[:60]!r}"
         )
     n_text = int(m.group(1)) if (m := _TEXT_LINES.search(first)) else 13
     text = [line for _, line in cursor.take(n_text, "text header")]
@@ -303,60 +428,122 @@ def _read_block(cursor: _Lines, name: str, headonly: bool):
         block = cursor.take(n_lines, f"{kind} data")
         if "acc" not in kind.lower() or trace is not None:
             continue  # velocity and displacement sections of V2 files
-        code, unit_text = _data_units(data_line, _value(ints, 3, int_null), name)
+        where = f"channel block at line {block_line}"
+        code, unit_text = _data_units(data_line, _value(ints, 3, int_null), name, where)
         trace = _make_trace(name, text, ints, reals, comments, (int_null, real_null),
-                            data_line, code, unit_text, npts)
+                            data_line, code, unit_text, npts, horizontals)
         if not headonly:
-            samples = _fixed_width(block, npts, per_line, width, name, f"{kind} data")
+            samples = _fixed_width(block, npts, per_line, width, name, f"{kind} data",
+                                   aligned=True)
             trace.data = make_trace(samples, trace.stats.delta, {}).data
             check_samples(trace.data, name, f"channel {trace.stats.channel}")
             factor = UNIT_CODES[code][1]
             if factor is not None:
                 trace.data *= factor
-    while not cursor.at_end() and cursor.peek().strip().lower().startswith("end-of-data"):
+    if cursor.at_end() or not _END_OF_DATA.match(cursor.peek()):
+        found = repr(cursor.peek()[:60]) if not cursor.at_end() else "the end of the file"
+        raise RecordError(
+            name, f"line {cursor.index + 1}: expected the end-of-data line of the channel block at"
+            f" line {block_line}, found {found} (truncated file or wrong sample count)"
+        )
+    while not cursor.at_end() and _END_OF_DATA.match(cursor.peek()):
         cursor.index += 1
     return trace
 
 
-def _make_trace(name, text, ints, reals, comments, nulls, data_line, code, unit_text, npts):
+def _channel(name, orientation, scnl, sampling_rate, horizontals, notes) -> tuple[str, dict]:
+    """SEED channel code and ``azimuth``/``dip`` entries of one block."""
+    if scnl is None:
+        if orientation is None:
+            return f"{band_code(sampling_rate)}NX", {}
+        index = orientation["index"]
+        if not orientation["vertical"] and index is None:
+            index = min(len(horizontals) + 1, 2)  # non-cardinal or unknown azimuths in file order
+        if not orientation["vertical"]:
+            horizontals.append(index)
+        stats = orientation_stats(
+            sampling_rate, vertical=orientation["vertical"], azimuth_deg=orientation["azimuth"],
+            positive_up=orientation["positive_up"], index=index or 1,
+        )
+        return stats.pop("channel"), stats
+    channel = scnl[1]
+    if orientation is None:
+        return channel, {}
+    stats = orientation_stats(
+        sampling_rate, vertical=orientation["vertical"], azimuth_deg=orientation["azimuth"],
+        positive_up=orientation["positive_up"], index=orientation["index"] or 1,
+    )
+    by_code = {"Z": "vertical", "N": "north", "E": "east"}.get(channel[-1])
+    by_header = "vertical" if orientation["vertical"] else "horizontal"
+    conflict = by_code is not None and (by_code == "vertical") != orientation["vertical"]
+    if not conflict and by_code in ("north", "east") and orientation["azimuth"] is not None:
+        target = 0.0 if by_code == "north" else 90.0
+        gap = abs(orientation["azimuth"] - target) % 360.0
+        if min(gap, 360.0 - gap) > CARDINAL_TOLERANCE_DEG:
+            conflict, by_header = True, f"azimuth {orientation['azimuth']:g} deg"
+    if conflict:
+        note = (
+            f"{orientation['source']}={orientation['code']} says {by_header} but the <SCNL>"
+            f" channel code {channel} says {by_code}; {orientation['source']} ignored, orientation"
+            " taken from the channel code"
+        )
+        notes.append(note)
+        warnings.warn(f"{name}: {note}", stacklevel=5)
+        return channel, {}
+    stats.pop("channel")
+    return channel, stats
+
+
+def _make_trace(name, text, ints, reals, comments, nulls, data_line, code, unit_text, npts,
+                horizontals):
     """Build the (still empty) trace of an acceleration section with its header."""
     int_null, real_null = nulls
+    notes: list[str] = []
     kind = _value(ints, 2, int_null)
     if kind is not None and int(kind) != 1:
         raise UnitsError(name, f"Int(2)={int(kind)}: the record is not an acceleration")
+    if kind is None:
+        notes.append("Int(2) unknown; the data line names the section an acceleration")
     delta_ms = _value(reals, 62, real_null)
     if delta_ms is None:
         raise RecordError(name, "the sampling interval Real(62) is unknown")
     delta = check_delta(delta_ms / 1000.0, name)
-    notes: list[str] = []
+    length = _value(reals, 63, real_null)
+    if length is not None and abs(length / delta - npts) > 1.0:
+        notes.append(f"Real(63) record length {length:g} s is not {npts} samples of {delta:g} s")
+
     sensor, source = _value(ints, 54, int_null), "Int(54)"
+    orientation = _orientation(sensor)
     relative = _value(ints, 55, int_null)
-    if sensor is None and relative is not None:
+    if orientation is None and relative is not None:
         # USGS NSMP structure arrays (e.g. NP.8040) leave Int(54) unknown and give the orientation
         # relative to the structure in Int(55): enough to tell vertical from horizontal, not the
-        # azimuth (700 = horizontal of unknown azimuth).
-        sensor, source = (relative if int(relative) in (400, 401, 402) else 700), "Int(55)"
-    orientation, letter = _orientation(sensor, notes)
-    for note in notes:
-        warnings.warn(f"{name}: {note}", stacklevel=4)
-    channel, location = "HN" + letter, ""
+        # geographic azimuth.
+        orientation, sensor, source = _orientation(relative), relative, "Int(55)"
+        if orientation is not None:
+            orientation.update(azimuth=None)
+    if orientation is not None:
+        orientation.update(source=source, code=int(sensor))
+        if orientation["note"]:
+            notes.append(orientation["note"])
+            warnings.warn(f"{name}: {orientation['note']}", stacklevel=4)
     scnl = _scnl(comments)
-    if scnl is not None:
-        channel, location = scnl[1], scnl[3]
-        vertical_by_code = channel[-1] == "Z"
-        if letter != "X" and (letter == "Z") != vertical_by_code:
-            kinds = ("horizontal", "vertical")
-            note = (
-                f"{source}={int(sensor)} says {kinds[letter == 'Z']} but the <SCNL> channel code"
-                f" {channel} says {kinds[vertical_by_code]}; {source} ignored, orientation taken"
-                " from the channel code"
-            )
-            notes.append(note)
-            warnings.warn(f"{name}: {note}", stacklevel=4)
-            orientation = {}
+    channel, orientation_entries = _channel(name, orientation, scnl, 1.0 / delta, horizontals,
+                                            notes)
+
     station_match = _STATION_CODE.search(text[4]) if len(text) > 4 else None
-    start = _start_time(ints, reals, int_null)
+    network = station_match.group(1).upper() if station_match else ""
+    station = station_match.group(2) if station_match else ""
+    network = "" if network == "--" else network
+    location = ""
+    if scnl is not None:
+        station, network, location = scnl[0], scnl[2], scnl[3]
+
+    start = _start_time(ints, reals, nulls, text, notes)
+    stage = _processing_stage(ints, int_null, text[0] if text else "", notes)
     unit_name, factor = UNIT_CODES[code]
+    peak, peak_time = _value(reals, 64, real_null), _value(reals, 65, real_null)
+    text_peak = _TEXT_PEAK.search(text[10]) if len(text) > 10 else None
     header = AttribDict(
         {
             "text_header": text,
@@ -366,23 +553,31 @@ def _make_trace(name, text, ints, reals, comments, nulls, data_line, code, unit_
             "data_line": data_line.strip(),
             "unit_code": code,
             "unit_text": unit_text,
-            "processing_stage": _value(ints, 1, int_null),
+            "processing_stage": stage,
             "orientation_code": _value(ints, 54, int_null),
+            "relative_orientation_code": relative,
             "scnl": scnl,
             "notes": notes,
             "start_time_known": start is not None,
+            "stated_peak": peak,
+            "stated_peak_time": peak_time,
+            "text_peak": float(text_peak.group(1)) if text_peak else None,
+            "text_peak_unit": text_peak.group(2) if text_peak else None,
+            "text_peak_time": float(text_peak.group(3)) if text_peak else None,
         }
     )
     stats = {
-        "network": station_match.group(1).upper() if station_match else "",
-        "station": station_match.group(2) if station_match else "",
+        "network": network,
+        "station": station,
         "location": location,
         "channel": channel,
         "units": "counts" if factor is None else "m/s**2",
         "original_units": unit_name,
         "shipblock_cosmos": header,
-        **orientation,
+        **orientation_entries,
     }
+    if peak is not None and factor is not None:
+        stats["stated_peak_si"] = abs(peak) * factor
     coordinates = [_value(reals, k, real_null) for k in (1, 2, 3)]
     if coordinates[0] is not None and coordinates[1] is not None:
         stats["coordinates"] = AttribDict(
@@ -396,7 +591,7 @@ def _make_trace(name, text, ints, reals, comments, nulls, data_line, code, unit_
 
 
 def read_cosmos(filename, headonly: bool = False, **kwargs) -> Stream:
-    """Read a COSMOS V1/V2 file into a Stream of acceleration traces.
+    """Read a COSMOS V0/V1/V2 file into a Stream of acceleration traces.
 
     Parameters
     ----------
@@ -411,8 +606,9 @@ def read_cosmos(filename, headonly: bool = False, **kwargs) -> Stream:
     -------
     obspy.Stream
         One trace per channel, in m/s^2 (``stats.units == "m/s**2"``) or raw counts
-        (``stats.units == "counts"``); ``stats.azimuth``/``stats.dip`` [deg] from Int(54), and the
-        original header in ``stats.shipblock_cosmos``.
+        (``stats.units == "counts"``); ``stats.azimuth``/``stats.dip`` [deg] from Int(54), the
+        stated peak in ``stats.stated_peak_si`` [m/s^2] and the original header in
+        ``stats.shipblock_cosmos``.
 
     Raises
     ------
@@ -425,9 +621,9 @@ def read_cosmos(filename, headonly: bool = False, **kwargs) -> Stream:
     cursor = _Lines(read_text(filename).splitlines(), name)
     if cursor.at_end():
         raise RecordError(name, "is empty")
-    traces = []
+    traces, horizontals = [], []
     while not cursor.at_end():
-        trace = _read_block(cursor, name, headonly)
+        trace = _read_block(cursor, name, headonly, horizontals)
         if trace is not None:
             traces.append(trace)
     if not traces:
