@@ -28,6 +28,8 @@ _LAZY = {
     "COMPONENT_KEY": "shipblock.motion",
     "rotate_to_azimuth": "shipblock.motion",
     "read_record": "shipblock.io",
+    "read_motions": "shipblock.collection",
+    "MotionSet": "shipblock.collection",
     "load_catalogue": "shipblock.catalogue",
     "ShipblockError": "shipblock.errors",
     "RecordError": "shipblock.errors",

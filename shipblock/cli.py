@@ -492,6 +492,16 @@ def cmd_plot(args):
 
 
 def cmd_bench(args):
+    if args.read:
+        import json
+
+        from shipblock.bench_readers import reader_throughput, write_reader_throughput
+
+        result = reader_throughput(args.read, min_seconds=0.3 if args.quick else 1.0)
+        write_reader_throughput(result, sys.stdout)
+        if args.output:
+            Path(args.output).write_text(json.dumps(result, indent=2))
+        return 0
     from shipblock.bench import run_benchmarks
 
     if args.campaign_runs is not None and args.campaign_runs < 0:
@@ -599,6 +609,9 @@ def build_parser():
                    help="cases per chunk of the campaign (default: about 100 chunks)")
     s.add_argument("--profile", metavar="FILE",
                    help="profile the campaign with cProfile and write the statistics to FILE")
+    s.add_argument("--read", nargs="+", metavar="SOURCE",
+                   help="only the readers' benchmark: files/s per format on these folders, globs"
+                        " or files")
     s.set_defaults(func=cmd_bench)
     return p
 

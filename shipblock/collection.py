@@ -11,7 +11,10 @@ Grouping key of a trace: network, station, location, the first two letters of th
 (band and instrument: one sensor; K-NET/KiK-net borehole and surface sensors have locations
 ``01``/``02``), the format, and, for formats whose files are processing volumes (CSMIP ``.V1``
 and ``.V2``, GeoNet ``.V1A`` and ``.V2A``, ...), the file's extension, so that a station's
-uncorrected and corrected volumes are two records, not one with six components.
+uncorrected and corrected volumes are two records, not one with six components. Traces of one
+key whose time windows do not overlap are different records (two earthquakes at one station,
+or a recording split in two files); a channel that still appears twice (two copies of one
+record, in two folders or two files) splits the group by folder, then by file.
 """
 
 from __future__ import annotations
@@ -40,7 +43,8 @@ NOT_WAVEFORMS = {".json", ".yml", ".yaml", ".md", ".toml", ".zip", ".png", ".jpg
 
 #: Formats whose components come one per file, named by the file's extension (the extension is
 #: then not a processing volume and does not enter the grouping key).
-_COMPONENT_PER_EXTENSION = {"KNET", "MSEED", "SAC", "SHIPBLOCK_ESM", "SHIPBLOCK_AT2"}
+_COMPONENT_PER_EXTENSION = {"KNET", "MSEED", "SAC", "SHIPBLOCK_ESM", "SHIPBLOCK_AT2",
+                            "SHIPBLOCK_USC", "SHIPBLOCK_SMC"}
 
 
 @dataclass
@@ -120,6 +124,44 @@ def _group_key(trace) -> tuple:
             fmt, volume)
 
 
+def _overlapping(stream: Stream) -> list[Stream]:
+    """Split traces into clusters whose time windows overlap."""
+    clusters: list[Stream] = []
+    end = None
+    for trace in sorted(stream, key=lambda tr: tr.stats.starttime):
+        if end is None or trace.stats.starttime > end:
+            clusters.append(Stream())
+            end = trace.stats.endtime
+        clusters[-1].append(trace)
+        end = max(end, trace.stats.endtime)
+    return clusters
+
+
+def _by(stream: Stream, part) -> list[Stream]:
+    """Split a stream by a function of each trace's source file, keeping file order."""
+    parts: dict[str, Stream] = {}
+    for trace in stream:
+        parts.setdefault(part(str(trace.stats.get("source_file", ""))), Stream()).append(trace)
+    return list(parts.values())
+
+
+def _repeats(stream: Stream) -> bool:
+    ids = [trace.id for trace in stream]
+    return len(ids) != len(set(ids))
+
+
+def _split_groups(groups: dict[tuple, Stream]):
+    """Yield ``(key, stream)`` records: time clusters, then copies split by folder and file."""
+    for key, stream in groups.items():
+        for cluster in _overlapping(stream):
+            parts = [cluster]
+            for split in (lambda f: str(Path(f).parent), lambda f: f):
+                if any(_repeats(p) for p in parts):
+                    parts = [q for p in parts for q in _by(p, split)]
+            for part in parts:
+                yield key, part
+
+
 def _label(key: tuple) -> str:
     network, station, location, sensor, fmt, volume = key
     if not (network or station):
@@ -194,7 +236,7 @@ def read_motions(source, inventory=None, units: str | None = None, *,
         for trace in stream:
             groups.setdefault(_group_key(trace), Stream()).append(trace)
 
-    for key, stream in groups.items():
+    for key, stream in _split_groups(groups):
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")

@@ -97,6 +97,15 @@ INPUT_UNITS_TO_SI: dict[str, tuple[str, float]] = {
 SAC_IDEP_UNITS = {8: "nm/s^2", 7: "nm/s"}
 SAC_IDEP_NAMES = {8: "IACC", 7: "IVEL"}
 
+#: What read_motion says of a record whose sensor (``stats.sensor_site``) is not at the free
+#: surface: neither is the motion at a dock's floor.
+SITE_NOTES = {
+    "structure": "the sensor is in a structure (a building, dam or bridge), not free-field:"
+                 " its record is the structure's response, not the ground motion",
+    "borehole": "the sensor is in a borehole below the surface (KiK-net 01): its record is the"
+                " motion at depth, not at the surface",
+}
+
 #: Mean of a vertical above which read_motion notes gravity or an offset in it [m/s^2].
 GRAVITY_NOTE_THRESHOLD = 0.5 * STANDARD_GRAVITY
 
@@ -329,11 +338,15 @@ def _by_sensitivity(trace, response, source_label, differentiate, name, note="")
     """Divide counts by a response's overall sensitivity; convert its input unit to SI."""
     sensitivity = response.instrument_sensitivity if response is not None else None
     value = None if sensitivity is None else sensitivity.value
-    if value is None or not (math.isfinite(value) and value > 0):
+    if value is None or not (math.isfinite(value) and value != 0):
         raise RecordError(
             name, f"{source_label} has no usable sensitivity for channel {trace.id}"
-            f" (value {value!r}; a positive finite number of counts per input unit is needed)"
+            f" (value {value!r}; a finite, non-zero number of counts per input unit is needed)"
         )
+    if value < 0:
+        # A negative sensitivity states a channel wired with reversed polarity (BK.VALB HN3 in
+        # real BK metadata): dividing by it restores the ground's sign.
+        note += " (negative: the channel's polarity is reversed and is restored)"
     input_units = sensitivity.input_units or ""
     quantity, factor = _input_unit(input_units)
     if quantity is None:
@@ -1183,6 +1196,11 @@ def read_motion(
                 trace, inv, inventory_name, units, response, differentiate
             )
         _check_finite(trace)
+    for component, trace in assigned.items():
+        site = trace.stats.get("sensor_site")
+        if site in SITE_NOTES:
+            notes.append(f"{component} ({trace.id}): {SITE_NOTES[site]}")
+            logger.warning("%s: %s", label, notes[-1])
     if "V" in assigned:
         mean = float(np.mean(assigned["V"].data))
         if abs(mean) > GRAVITY_NOTE_THRESHOLD:

@@ -33,6 +33,8 @@ ACCELERATION_UNITS_TO_SI: dict[str, float] = {
     "in/s^2": INCH,
     "in/s**2": INCH,
     "g": STANDARD_GRAVITY,
+    "mg": STANDARD_GRAVITY * 1e-3,
+    "micro-g": STANDARD_GRAVITY * 1e-6,
 }
 
 

@@ -244,3 +244,70 @@ def test_cli_info_on_a_folder_with_sensor_flag(tmp_path, capsys):
     files = [line.split()[-1] for line in capsys.readouterr().out.splitlines()
              if line.startswith("file")]
     assert sorted(f[-3:] for f in files) == ["EW1", "NS1", "UD1"]  # the borehole sensor only
+
+
+def test_negative_sensitivity_restores_polarity():
+    """BK.VALB's channels have sensitivity -4279779.834 counts/(m/s^2) in the real StationXML.
+
+    HN1 is the vertical there (dip -90), HN2 and HN3 the horizontals at 336 and 246 deg.
+    """
+    files = [corpus_file(f"fdsn/nc73300395/BK.VALB.40.HN{c}__20191103T203452Z__20191103T203627Z.mseed")
+             for c in "123"]
+    xml = corpus_file("fdsn/nc73300395/BK.VALB.xml")
+    gm = read_motion(files, inventory=xml)
+    response = obspy.read_inventory(str(xml)).select(channel="HN1")[0][0][0].response
+    value = response.instrument_sensitivity.value
+    assert value == -4279779.834
+    assert gm.metadata["channels"] == {"H1": "BK.VALB.40.HN3", "H2": "BK.VALB.40.HN2",
+                                       "V": "BK.VALB.40.HN1"}
+    raw = obspy.read(str(files[0]))[0]
+    offset = round((gm.starttime - raw.stats.starttime) / raw.stats.delta)
+    np.testing.assert_allclose(gm.components["V"],
+                               raw.data[offset: offset + gm.npts] / value, rtol=1e-12)
+    assert "polarity is reversed" in gm.metadata["units"]["V"]
+
+
+def test_structure_and_borehole_sensors_are_said():
+    structure = read_motion(corpus_file("smc/nc216859/891018_1.cra-1.0210a.smc"))
+    assert any("not free-field" in note for note in structure.metadata["notes"])
+    files = [corpus_file(f"kiknet/usp000hzq8/NGNH311106302345.{d}1") for d in ("NS", "EW", "UD")]
+    assert any("borehole" in note for note in read_motion(files).metadata["notes"])
+
+
+def test_every_corpus_folder_grouped_into_records():
+    """Copies and split recordings become separate records; every failure is a named reason."""
+    expected = {"dmg": (10, 2), "geonet2": (6, 0), "renadic": (28, 0), "usc": (4, 0),
+                "station_xml_epochs": (2, 0)}
+    for folder, (records, failures) in expected.items():
+        from tests.real_corpus import find_corpus_file
+
+        files = [rel for rel in _FOLDER_FILES[folder] if find_corpus_file(rel) is not None]
+        if len(files) != len(_FOLDER_FILES[folder]):
+            pytest.skip("real corpus not found")
+        found = read_motions([find_corpus_file(rel) for rel in files])
+        assert (len(found), len(found.failures)) == (records, failures), (folder, found.failures)
+        for motion in found:
+            ids = list(motion.metadata["channels"].values())
+            assert len(ids) == len(set(ids))
+
+
+_FOLDER_FILES = {
+    "dmg": ["dmg/ci15481673/CIWLT.RAW", "dmg/ci15481673/CIWLT.V2", "dmg/ci15481673/CIWLT.V3",
+            "dmg/ci3031425/NEWPORT.RAW", "dmg/ci3031425/ce23583r_HESPERIA.RAW",
+            "dmg/ci3144585/LA116TH.RAW", "dmg/nc1091100/ce36456p_CE36456.V2",
+            "dmg/nc71734741/BadHeader.V2", "dmg/nc71734741/CE89146.V1",
+            "dmg/nc71734741/CE89146.V2", "dmg/nc71734741/CE89146.V3",
+            "dmg/nc72282711/CE58667.V2"],
+    "geonet2": ["geonet2/2019p314352/20190427_072659_HCDS_20.V1A",
+                "geonet2/2019p314352/20190427_072700_HNPS_20.V1A",
+                "geonet2/2019p322376/20190430_064319_INHS_21.V1A",
+                "geonet2/2019p322376/20190430_064339_TBAS_20.V1A",
+                "geonet2/2019p323787/20190430_191422_HCDS_20.V1A",
+                "geonet2/2019p323787/20190430_191422_HNPS_20.V1A"],
+    "renadic": [f for f in reference_files("renadic")],
+    "usc": [f"usc/ci3144585/017m30{n}" for n in ("bt.s0a", "cc.y0a", "lw.e0a", "lw.e0b", "lw.e0c",
+                                                  "lw.s0a", "lw.s0b", "lw.s0c")],
+    "station_xml_epochs": [f"station_xml_epochs/{d}/NP.1767{s}" for d in ("nc73631381",
+                           "nc73631381_ad") for s in ("..HNE.mseed", "..HNN.mseed", "..HNZ.mseed",
+                                                      ".xml")],
+}

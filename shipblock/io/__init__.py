@@ -10,8 +10,20 @@ format            module                             what
 SHIPBLOCK_AT2     :mod:`shipblock.io.at2`            PEER NGA ``.AT2`` (g)
 SHIPBLOCK_COSMOS  :mod:`shipblock.io.cosmos`         COSMOS / CSMIP V1 and V2 (unit codes)
 SHIPBLOCK_ESM     :mod:`shipblock.io.esm`            ESM ASCII (``UNITS`` key)
+SHIPBLOCK_DMG     :mod:`shipblock.io.dmg`            CSMIP/CDMG V1, V2 and RAW (CESMD)
+SHIPBLOCK_GEONET  :mod:`shipblock.io.geonet`         GeoNet V1A/V2A (New Zealand)
+SHIPBLOCK_CWB     :mod:`shipblock.io.cwb`            CWB (Taiwan) ``.dat``
+SHIPBLOCK_NSMN    :mod:`shipblock.io.nsmn`           AFAD/NSMN text (Turkey)
+SHIPBLOCK_BHRC    :mod:`shipblock.io.bhrc`           BHRC V1 (Iran)
+SHIPBLOCK_UNAM    :mod:`shipblock.io.unam`           UNAM ASA (Mexico)
+SHIPBLOCK_RENADIC :mod:`shipblock.io.renadic`        RENADIC ``.v1`` (Chile)
+SHIPBLOCK_USC     :mod:`shipblock.io.usc`            USC volumes (Los Angeles)
+SHIPBLOCK_SMC     :mod:`shipblock.io.smc`            USGS SMC
 SHIPBLOCK_TEXT    :mod:`shipblock.io.text`           one/two-column text or CSV (stated units)
 ================  =================================  ==========================================
+
+K-NET and KiK-net files are read by obspy and renamed the SEED way by
+:func:`shipblock.io.knet.normalise_knet`.
 
 :func:`read_record` wraps :func:`obspy.read` so that every failure becomes a
 :class:`~shipblock.errors.RecordError` naming the file, and so that plain text files (which obspy
@@ -26,7 +38,7 @@ import warnings
 import obspy
 
 from shipblock.errors import RecordError, ShipblockError
-from shipblock.io import at2, cosmos, esm, text
+from shipblock.io import at2, bhrc, cosmos, cwb, dmg, esm, geonet, nsmn, renadic, smc, text, unam, usc
 from shipblock.io._common import peek_text
 from shipblock.io.knet import normalise_knet
 
@@ -37,6 +49,15 @@ FORMATS = {
     at2.FORMAT: (at2.is_at2, at2.read_at2),
     cosmos.FORMAT: (cosmos.is_cosmos, cosmos.read_cosmos),
     esm.FORMAT: (esm.is_esm, esm.read_esm),
+    dmg.FORMAT: (dmg.is_dmg, dmg.read_dmg),
+    geonet.FORMAT: (geonet.is_geonet, geonet.read_geonet),
+    cwb.FORMAT: (cwb.is_cwb, cwb.read_cwb),
+    nsmn.FORMAT: (nsmn.is_nsmn, nsmn.read_nsmn),
+    bhrc.FORMAT: (bhrc.is_bhrc, bhrc.read_bhrc),
+    unam.FORMAT: (unam.is_unam, unam.read_unam),
+    renadic.FORMAT: (renadic.is_renadic, renadic.read_renadic),
+    usc.FORMAT: (usc.is_usc, usc.read_usc),
+    smc.FORMAT: (smc.is_smc, smc.read_smc),
     text.FORMAT: (text.is_text, text.read_text_record),
 }
 
