@@ -962,8 +962,8 @@ class GroundMotion:
         if cat.get("id"):
             return str(cat["id"])
         st = md.get("station")
-        if isinstance(st, dict):
-            return f"{st.get('network', '')}.{st.get('station', '')}"
+        if isinstance(st, dict) and (st.get("network") or st.get("station")):
+            return ".".join(code for code in (st.get("network"), st.get("station")) if code)
         return str(st or md.get("name") or "record")
 
     @property
@@ -1016,7 +1016,8 @@ class GroundMotion:
                 if az.get("H1") is None or az.get("H2") is None:
                     raise RecordError(
                         self._label, "azimuths of the horizontals are unknown; cannot rotate"
-                        " (give horizontal='H1'/'H2' instead, or an inventory with azimuths)"
+                        " (give horizontal='H1'/'H2' instead, command line --horizontal H1, or an"
+                        " inventory with azimuths, --inventory FILE)"
                     )
                 try:
                     return rotate_to_azimuth(comps["H1"], comps["H2"], az["H1"], az["H2"],
@@ -1074,13 +1075,16 @@ def _one_of_folder(source, inventory, units, response, differentiate, align, gap
     found = read_motions(source, inventory=inventory, units=units, response=response,
                          differentiate=differentiate, align=align, gaps=gaps, event=event)
     label = os.fspath(source)
-    if len(found) != 1:
-        failures = "".join(f"\n  {where}: {why}" for where, why in found.failures)
+    failures = "".join(f"\n  {where}: {why}" for where, why in found.failures)
+    if not found.motions:
+        raise RecordError(label, "no record could be read from it:" + failures)
+    if len(found) > 1:
         raise RecordError(
             label,
             f"holds {len(found)} records ("
             + ", ".join(m.name for m in found.motions)
-            + "); read_motions() returns them all, or name the files of one" + failures,
+            + "); read_motions() (command line: shipblock catalogue) reads them all; name the"
+            " files of one" + failures,
         )
     motion = found.motions[0]
     if azimuth is not None or horizontal is not None:
