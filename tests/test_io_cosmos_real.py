@@ -20,6 +20,9 @@ import numpy as np
 import obspy
 import pytest
 
+from shipblock.errors import RecordError, UnitsError
+from shipblock.io.cosmos import is_cosmos, read_cosmos
+from tests.reader_fuzz import assert_reader_survives
 from tests.real_corpus import (
     REFERENCE,
     assert_peaks_match_gmprocess,
@@ -27,9 +30,6 @@ from tests.real_corpus import (
     gmprocess_read,
     reference_files,
 )
-from tests.reader_fuzz import assert_reader_survives
-from shipblock.errors import RecordError, UnitsError
-from shipblock.io.cosmos import is_cosmos, read_cosmos
 
 CM = 0.01  # 1 cm/s^2 = 0.01 m/s^2 (exact)
 

@@ -8,7 +8,6 @@ values: gmprocess 2.8.0's peaks (tests/data/reference), the files' own stated pe
 from __future__ import annotations
 
 import shutil
-import warnings
 
 import numpy as np
 import obspy

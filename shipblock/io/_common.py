@@ -13,7 +13,7 @@ import os
 import re
 
 import numpy as np
-from obspy import Trace
+from obspy import Trace, UTCDateTime
 
 from shipblock.errors import RecordError, UnitsError
 from shipblock.units import ACCELERATION_UNITS_TO_SI
@@ -24,6 +24,23 @@ PEEK_BYTES = 8192
 #: Largest text record a reader accepts [bytes]; guards against feeding a huge binary file to a
 #: text parser (the largest real accelerogram text files are a few tens of MB).
 MAX_TEXT_BYTES = 512 * 1024 * 1024
+
+#: Largest absolute acceleration accepted as a ground motion [m/s^2] (100 g; the largest recorded
+#: ground accelerations are about 4 g): anything above is a corrupt number, not a record.
+MAX_ACCELERATION_SI = 980.665
+
+#: Range of sampling intervals accepted [s] (10 kHz to 1 Hz); outside it the header is corrupt.
+MIN_SAMPLING_INTERVAL_S = 1e-4
+MAX_SAMPLING_INTERVAL_S = 1.0
+
+#: Sampling rate onto which unevenly digitized (time, value) records are interpolated
+#: [samples/s].
+DEFAULT_RESAMPLE_RATE_HZ = 200.0
+
+#: Longest gap between two digitized points bridged by interpolation [s]. The real files'
+#: largest gap is 0.037 s (SMC) and 0.013 s (USC); a quarter second without a point would hide
+#: the 1-25 Hz motion of the record, so a longer gap is taken for a corrupt time column.
+MAX_DIGITIZATION_GAP_S = 0.25
 
 #: A floating-point number as written by Fortran or C (``1.0``, ``-.25E-03``, ``3``, ``1.2D+01``).
 FLOAT_RE = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?")
@@ -175,6 +192,60 @@ def parse_float(token: str) -> float:
     return float(token.strip().replace("D", "E").replace("d", "e"))
 
 
+def parse_number(raw: str, name: str, what: str) -> float:
+    """Parse one finite header number, or raise a :class:`RecordError` naming it.
+
+    Parameters
+    ----------
+    raw : str
+        The number as written (Fortran ``D`` exponents accepted).
+    name : str
+        File name, for error messages.
+    what : str
+        What the number is, put before it in error messages (e.g. ``"NO. OF POINTS"``).
+
+    Returns
+    -------
+    float
+        The value.
+
+    Raises
+    ------
+    RecordError
+        If ``raw`` is not a number, or is NaN or infinite.
+    """
+    try:
+        value = parse_float(raw)
+    except ValueError:
+        raise RecordError(name, f"{what} {raw!r} is not a number") from None
+    if not math.isfinite(value):
+        raise RecordError(name, f"{what} {raw!r} is not a finite number")
+    return value
+
+
+def fixed_fields(line: str, width: int, count: int | None = None) -> list[str]:
+    """Cut a line into Fortran fixed-width fields (not stripped).
+
+    Parameters
+    ----------
+    line : str
+        The line (strip its end first if trailing blanks must not make fields).
+    width : int
+        Field width [characters].
+    count : int, optional
+        Number of fields to cut, whatever the line's length (fields beyond its end are ``""``);
+        by default as many as the line holds, the last one possibly shorter.
+
+    Returns
+    -------
+    list of str
+        The fields.
+    """
+    if count is None:
+        return [line[i : i + width] for i in range(0, len(line), width)]
+    return [line[k * width : (k + 1) * width] for k in range(count)]
+
+
 def parse_free_floats(lines, name: str, what: str) -> np.ndarray:
     """Parse whitespace-separated numbers from lines of text.
 
@@ -294,6 +365,147 @@ def check_delta(delta: float, name: str) -> float:
     return float(delta)
 
 
+def check_sampling_interval(delta: float, name: str, what: str = "sampling interval") -> float:
+    """Validate a sampling interval [s] against the plausible range and return it as a float.
+
+    Parameters
+    ----------
+    delta : float
+        Sampling interval [s].
+    name : str
+        File name, for the error message.
+    what : str, optional
+        Words put before the interval in the error message.
+
+    Returns
+    -------
+    float
+        The interval [s].
+
+    Raises
+    ------
+    RecordError
+        If the interval is not a finite positive number, or lies outside
+        [:data:`MIN_SAMPLING_INTERVAL_S`, :data:`MAX_SAMPLING_INTERVAL_S`].
+    """
+    delta = check_delta(delta, name)
+    if not MIN_SAMPLING_INTERVAL_S <= delta <= MAX_SAMPLING_INTERVAL_S:
+        raise RecordError(name, f"{what} {delta:g} s is outside"
+                                f" [{MIN_SAMPLING_INTERVAL_S:g}, {MAX_SAMPLING_INTERVAL_S:g}] s")
+    return delta
+
+
+def check_plausible_samples(data_si: np.ndarray, name: str, what: str) -> float:
+    """Refuse accelerations larger than :data:`MAX_ACCELERATION_SI`; return the peak.
+
+    Parameters
+    ----------
+    data_si : numpy.ndarray
+        Finite, non-empty samples [m/s^2].
+    name : str
+        File name, for the error message.
+    what : str
+        Which record or channel (for the error message).
+
+    Returns
+    -------
+    float
+        The largest absolute sample [m/s^2].
+
+    Raises
+    ------
+    RecordError
+        If a sample exceeds :data:`MAX_ACCELERATION_SI` in magnitude.
+    """
+    peak = float(np.max(np.abs(data_si)))
+    if peak > MAX_ACCELERATION_SI:
+        raise RecordError(name, f"{what} has a sample of {peak:.3g} m/s^2, not a ground"
+                                " acceleration (corrupt number or wrong unit?)")
+    return peak
+
+
+def utc_time(year: int, month: int, day: int, hour: int = 0, minute: int = 0,
+             second: float = 0.0) -> UTCDateTime | None:
+    """The UTC time of calendar fields, or ``None`` if they name no valid time.
+
+    Parameters
+    ----------
+    year, month, day, hour, minute : int
+        Calendar fields.
+    second : float, optional
+        Seconds [s] added after the minute (may hold a fraction).
+
+    Returns
+    -------
+    obspy.UTCDateTime or None
+        The time; ``None`` for an impossible date (the caller words the error).
+    """
+    try:
+        return UTCDateTime(year, month, day, hour, minute) + second
+    except Exception:  # noqa: BLE001 - obspy raises several types for impossible dates
+        return None
+
+
+def resample_pairs(times, values, rate_hz: float, name: str):
+    """Interpolate unevenly digitized (time, value) pairs onto an even grid.
+
+    Parameters
+    ----------
+    times : numpy.ndarray
+        Digitized times [s], non-decreasing.
+    values : numpy.ndarray
+        Values at those times (any unit).
+    rate_hz : float
+        Sampling rate of the grid [samples/s].
+    name : str
+        File name, for error messages.
+
+    Returns
+    -------
+    tuple
+        ``(samples, first_time_s, merged)``: the samples at ``first_time_s + k / rate_hz`` up to
+        the last digitized time, the first digitized time [s], and how many repeated times were
+        merged (their values averaged).
+
+    Raises
+    ------
+    RecordError
+        If times go backwards, jump by more than :data:`MAX_DIGITIZATION_GAP_S`, are not finite,
+        or span no time.
+    """
+    times = np.asarray(times, dtype=np.float64)
+    values = np.asarray(values, dtype=np.float64)
+    if not (isinstance(rate_hz, (int, float)) and math.isfinite(rate_hz) and rate_hz > 0):
+        raise RecordError(name, f"resample rate {rate_hz!r} Hz is not a positive number")
+    if times.size < 2 or not np.all(np.isfinite(times)):
+        raise RecordError(name, "digitized times are missing or not finite")
+    steps = np.diff(times)
+    back = np.flatnonzero(steps < 0)
+    if back.size:
+        i = int(back[0])
+        raise RecordError(
+            name, f"digitized times go backwards at pair {i + 2} ({times[i]:g} s then"
+            f" {times[i + 1]:g} s)"
+        )
+    if steps.max() > MAX_DIGITIZATION_GAP_S:
+        i = int(np.argmax(steps))
+        raise RecordError(
+            name, f"digitized times jump by {steps[i]:g} s at pair {i + 2} (more than"
+            f" {MAX_DIGITIZATION_GAP_S:g} s; corrupt time column)"
+        )
+    unique, inverse = np.unique(times, return_inverse=True)
+    if unique.size < 2:
+        raise RecordError(name, "digitized times span no time")
+    merged = times.size - unique.size
+    if merged:
+        values = np.bincount(inverse, weights=values) / np.bincount(inverse)
+    span = unique[-1] - unique[0]
+    # The small allowance keeps a last digitized time that falls on the grid.
+    count = int(math.floor(span * rate_hz + 1e-6)) + 1
+    grid = unique[0] + np.arange(count) / rate_hz
+    return np.interp(grid, unique, values), float(unique[0]), merged
+
+
 def make_trace(data, delta: float, stats: dict) -> Trace:
     """Build an obspy Trace of float64 samples.
 
@@ -335,6 +547,26 @@ def band_code(sampling_rate: float) -> str:
     if sampling_rate > 1.0:
         return "M"
     return "L"
+
+
+def horizontal_index(azimuth_deg: float) -> int:
+    """SEED orientation digit of a horizontal that is not along north or east.
+
+    ``1`` for an axis nearer north-south (or exactly on a diagonal through the north-east
+    quadrant), ``2`` for one nearer east-west.
+
+    Parameters
+    ----------
+    azimuth_deg : float
+        Azimuth of the positive direction [deg clockwise from north].
+
+    Returns
+    -------
+    int
+        ``1`` or ``2``.
+    """
+    axis = azimuth_deg % 180.0
+    return 1 if axis <= 45.0 or axis > 135.0 else 2
 
 
 def orientation_stats(sampling_rate: float, *, vertical: bool, azimuth_deg: float | None = None,

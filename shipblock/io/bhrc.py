@@ -56,14 +56,17 @@ import math
 import re
 
 import numpy as np
-from obspy import Stream, UTCDateTime
+from obspy import Stream
 from obspy.core import AttribDict
 
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
     check_delta,
+    check_plausible_samples,
     check_samples,
+    check_sampling_interval,
+    fixed_fields,
     make_trace,
     orientation_stats,
     parse_float,
@@ -71,6 +74,7 @@ from shipblock.io._common import (
     read_text,
     si_factor,
     source_name,
+    utc_time,
 )
 from shipblock.units import STANDARD_GRAVITY
 
@@ -104,14 +108,6 @@ END_MARKER = "/&"
 
 #: m/s^2 per unit of ``G/10``.
 G_OVER_10_SI = STANDARD_GRAVITY / 10.0
-
-#: Largest absolute acceleration accepted as a ground motion [m/s^2] (100 g; the largest recorded
-#: ground accelerations are about 4 g): anything above is a corrupt number, not a record.
-MAX_ACCELERATION_SI = 980.665
-
-#: Range of sampling intervals accepted [s] (10 kHz to 1 Hz); outside it the header is corrupt.
-MIN_SAMPLING_INTERVAL_S = 1e-4
-MAX_SAMPLING_INTERVAL_S = 1.0
 
 #: Printed precision of ``DURATION`` [s] (three decimals), for the consistency check.
 DURATION_PRINT_STEP_S = 0.001
@@ -175,9 +171,8 @@ def _ints(lines, name, first_line):
     """Parse the I5 integer header."""
     values = []
     for offset, line in enumerate(lines):
-        row = line.rstrip()
-        for start in range(0, len(row), INT_WIDTH):
-            field = row[start:start + INT_WIDTH].strip()
+        for field in fixed_fields(line.rstrip(), INT_WIDTH):
+            field = field.strip()
             if not field:
                 values.append(0)
                 continue
@@ -194,8 +189,8 @@ def _reals(lines, name, first_line):
     values = []
     for offset, line in enumerate(lines):
         row = line.rstrip("\r\n")
-        for position in range(REALS_PER_LINE):
-            field = row[position * REAL_WIDTH:(position + 1) * REAL_WIDTH].strip()
+        for position, field in enumerate(fixed_fields(row, REAL_WIDTH, REALS_PER_LINE)):
+            field = field.strip()
             if not field:
                 values.append(0.0)
                 continue
@@ -214,9 +209,8 @@ def _samples(lines, name, first_line):
     """Parse E13.6 sample lines."""
     values = []
     for offset, line in enumerate(lines):
-        row = line.rstrip()
-        for start in range(0, len(row), SAMPLE_WIDTH):
-            field = row[start:start + SAMPLE_WIDTH].strip()
+        for field in fixed_fields(line.rstrip(), SAMPLE_WIDTH):
+            field = field.strip()
             if not field:
                 continue
             try:
@@ -245,12 +239,11 @@ def _text_header(lines, name, first_line):
     origin = _ORIGIN_RE.search(body)
     if origin is not None:
         year, month, day, hour, minute = (int(g) for g in origin.groups()[:5])
-        try:
-            header["origin_time"] = str(UTCDateTime(year, month, day, hour, minute)
-                                        + float(origin.group(6)))
-        except Exception:  # noqa: BLE001 - obspy raises several types for impossible dates
+        origin_time = utc_time(year, month, day, hour, minute, float(origin.group(6)))
+        if origin_time is None:
             raise RecordError(name, f"Origin Time {origin.group(0)!r} is not a valid date and"
-                                    " time") from None
+                                    " time")
+        header["origin_time"] = str(origin_time)
     component = lines[4].strip().upper()
     comp = re.match(r"\s*COMP\s+(\S+)", lines[6], re.IGNORECASE)
     header["comp"] = comp.group(1) if comp else ""
@@ -306,10 +299,7 @@ def _delta(header, name):
         delta = check_delta(duration / npts, name)
     else:
         raise RecordError(name, f"{what}: sampling rate {rate!r} is not a positive number")
-    if not MIN_SAMPLING_INTERVAL_S <= delta <= MAX_SAMPLING_INTERVAL_S:
-        raise RecordError(name, f"{what}: sampling interval {delta:g} s is outside"
-                                f" [{MIN_SAMPLING_INTERVAL_S:g}, {MAX_SAMPLING_INTERVAL_S:g}] s")
-    return delta
+    return check_sampling_interval(delta, name, f"{what}: sampling interval")
 
 
 def read_bhrc(filename, headonly: bool = False, **kwargs) -> Stream:
@@ -413,10 +403,7 @@ def read_bhrc(filename, headonly: bool = False, **kwargs) -> Stream:
             trace = make_trace(samples, delta, stats)
             check_samples(trace.data, name, what)
             trace.data *= factor
-            peak = float(np.max(np.abs(trace.data)))
-            if peak > MAX_ACCELERATION_SI:
-                raise RecordError(name, f"{what} has a sample of {peak:.3g} m/s^2, not a ground"
-                                        " acceleration (corrupt number?)")
+            check_plausible_samples(trace.data, name, what)
         stream.append(trace)
         position = end + 1
     if not stream:

@@ -91,6 +91,7 @@ from shipblock.io._common import (
     band_code,
     check_delta,
     check_samples,
+    fixed_fields,
     make_trace,
     orientation_stats,
     parse_float,
@@ -208,8 +209,7 @@ def _fixed_width(lines, count: int, per_line: int, width: int, name: str, what: 
                 name, f"line {lineno}: the {what} line ends inside a {width}-character field"
                 " (truncated or corrupt file)"
             )
-        for k in range(per_line):
-            field = line[k * width : (k + 1) * width]
+        for field in fixed_fields(line, width, per_line):
             if not field.strip():
                 continue
             try:

@@ -45,7 +45,6 @@ coordinates of the header (no elevation is stated: 0) and the header in ``stats.
 
 from __future__ import annotations
 
-import math
 import re
 
 import numpy as np
@@ -55,11 +54,14 @@ from obspy.core import AttribDict
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
-    check_delta,
+    check_plausible_samples,
     check_samples,
+    check_sampling_interval,
+    fixed_fields,
     make_trace,
     orientation_stats,
     parse_float,
+    parse_number,
     peek_text,
     read_text,
     si_factor,
@@ -73,14 +75,6 @@ FORMAT = "SHIPBLOCK_CWB"
 
 #: SEED network code of the Taiwan strong-motion network.
 NETWORK = "TW"
-
-#: Largest absolute acceleration accepted as a ground motion [m/s^2] (100 g; the largest recorded
-#: ground accelerations are about 4 g): anything above is a corrupt number, not a record.
-MAX_ACCELERATION_SI = 980.665
-
-#: Range of sampling intervals accepted [s] (10 kHz to 1 Hz); outside it the header is corrupt.
-MIN_SAMPLING_INTERVAL_S = 1e-4
-MAX_SAMPLING_INTERVAL_S = 1.0
 
 #: First line of every CWB file.
 FIRST_LINE = "#Earthquake Information"
@@ -162,13 +156,7 @@ def _number(header, prefix, name, required=True):
         if required:
             raise RecordError(name, f"header key #{prefix} is missing or empty")
         return None
-    try:
-        value = parse_float(raw)
-    except ValueError:
-        raise RecordError(name, f"header key #{key}: {raw!r} is not a number") from None
-    if not math.isfinite(value):
-        raise RecordError(name, f"header key #{key}: {raw!r} is not a finite number")
-    return value
+    return parse_number(raw, name, f"header key #{key}:")
 
 
 def _local_time(header, prefix, name):
@@ -231,7 +219,7 @@ def _rows(lines, ncols, width, name):
                     f"data row {row + 1} is {len(line)} characters long; {ncols} fields of "
                     f"{width} characters were expected",
                 )
-            fields = [line[k * width:(k + 1) * width] for k in range(ncols)]
+            fields = fixed_fields(line, width, ncols)
         else:
             fields = line.split()
             if len(fields) != ncols:
@@ -299,13 +287,8 @@ def read_cwb(filename, headonly: bool = False, **kwargs) -> Stream:
     rate = _number(header, "SampleRate", name)
     if rate <= 0:
         raise RecordError(name, f"#SampleRate {rate:g} Hz is not positive")
-    delta = check_delta(1.0 / rate, name)
-    if not MIN_SAMPLING_INTERVAL_S <= delta <= MAX_SAMPLING_INTERVAL_S:
-        raise RecordError(
-            name,
-            f"#SampleRate {rate:g} Hz gives a sampling interval outside "
-            f"[{MIN_SAMPLING_INTERVAL_S:g}, {MAX_SAMPLING_INTERVAL_S:g}] s",
-        )
+    delta = check_sampling_interval(1.0 / rate, name,
+                                    f"#SampleRate {rate:g} Hz: sampling interval")
     length = _number(header, "RecordLength", name, required=False)
     columns = _columns(header, name)
 
@@ -388,13 +371,7 @@ def read_cwb(filename, headonly: bool = False, **kwargs) -> Stream:
             samples = table[:, index]
             check_samples(samples, name, f"component {letter}")
             trace = make_trace(samples * factor, delta, trace_stats)
-            peak_si = float(np.max(np.abs(trace.data)))
-            if peak_si > MAX_ACCELERATION_SI:
-                raise RecordError(
-                    name,
-                    f"component {letter} has a sample of {peak_si:.3g} m/s^2, not a ground "
-                    "acceleration (corrupt number or wrong unit?)",
-                )
+            check_plausible_samples(trace.data, name, f"component {letter}")
         if start is not None:
             trace.stats.starttime = start + first_time
         traces.append(trace)

@@ -91,7 +91,9 @@ from shipblock.io._common import (
     FLOAT_RE,
     canonical_unit,
     check_delta,
+    check_plausible_samples,
     check_samples,
+    fixed_fields,
     make_trace,
     orientation_stats,
     parse_float,
@@ -109,10 +111,6 @@ FORMAT = "SHIPBLOCK_DMG"
 
 #: FDSN code of the California Strong Motion Instrumentation Program.
 NETWORK = "CE"
-
-#: Largest absolute acceleration accepted as a ground motion [m/s^2] (100 g; the largest recorded
-#: ground accelerations are about 4 g): anything above is a corrupt number, not a record.
-MAX_ACCELERATION_SI = 980.665
 
 #: Largest ratio of samples after and before interpolating time/value pairs onto an even grid.
 MAX_RESAMPLE_FACTOR = 100
@@ -275,8 +273,8 @@ def _header_numbers(lines, first, count, width, parse, name, what):
         if len(text) != expected * width:
             raise RecordError(name, f"line {first + offset + 1}: {what} line has {len(text)}"
                                     f" characters, not {expected} fields of {width}")
-        for k in range(expected):
-            field = text[k * width:(k + 1) * width].strip()
+        for field in fixed_fields(text, width, expected):
+            field = field.strip()
             if not field or set(field) == {"*"}:
                 values.append(None)  # blank, or a Fortran field overflow
                 continue
@@ -304,7 +302,7 @@ def _layout(start_line: str, first_data: str | None, total: int, name: str, line
         if count < 1 or len(text) % count:
             continue
         width = len(text) // count
-        fields = [text[k * width:(k + 1) * width] for k in range(count)]
+        fields = fixed_fields(text, width, count)
         if width >= 2 and all(_clean_field(f) for f in fields):
             return per_line, width
     raise RecordError(name, f"line {lineno + 1}: cannot tell the column layout of the data (no"
@@ -339,8 +337,8 @@ def _series(lines, first, total, per_line, width, name, what):
         if len(text) > count * width or len(text) <= (count - 1) * width:
             raise RecordError(name, f"line {index + 1}: {what}: expected {count} values of"
                                     f" {width} characters, found {len(text)} characters")
-        for k in range(count):
-            field = text[k * width:(k + 1) * width].strip()
+        for k, field in enumerate(fixed_fields(text, width, count)):
+            field = field.strip()
             if not field or " " in field:
                 raise RecordError(name, f"line {index + 1}: {what}: field {k + 1} {field!r} is"
                                         " not one number")
@@ -714,10 +712,7 @@ def _read_channel(volume, start, block, has_marker, name, headonly, resample_int
     units = "counts" if factor is None else "m/s**2"
     if factor is not None:
         data = data * factor
-        peak = float(np.max(np.abs(data)))
-        if peak > MAX_ACCELERATION_SI:
-            raise RecordError(name, f"channel {number}: peak acceleration {peak:.4g} m/s^2 is"
-                                    " not a ground motion (corrupt samples or wrong unit)")
+        peak = check_plausible_samples(data, name, f"channel {number} acceleration")
         if stated is not None:
             _, peak_factor = _unit(stated.group(2), name)
             value = parse_float(stated.group(1))

@@ -59,14 +59,17 @@ from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
     canonical_unit,
-    check_delta,
+    check_plausible_samples,
     check_samples,
+    check_sampling_interval,
+    fixed_fields,
     make_trace,
     orientation_stats,
     peek_text,
     read_text,
     si_factor,
     source_name,
+    utc_time,
 )
 
 __all__ = ["FORMAT", "is_geonet", "read_geonet"]
@@ -76,14 +79,6 @@ FORMAT = "SHIPBLOCK_GEONET"
 
 #: SEED network code of GeoNet.
 NETWORK = "NZ"
-
-#: Largest absolute acceleration accepted as a ground motion [m/s^2] (100 g; the largest recorded
-#: ground accelerations are about 4 g): anything above is a corrupt number, not a record.
-MAX_ACCELERATION_SI = 980.665
-
-#: Range of sampling intervals accepted [s] (10 kHz to 1 Hz); outside it the header is corrupt.
-MIN_SAMPLING_INTERVAL_S = 1e-4
-MAX_SAMPLING_INTERVAL_S = 1.0
 
 #: Components a GeoNet file holds.
 COMPONENTS_PER_FILE = 3
@@ -136,7 +131,7 @@ def _fixed_fields(line: str, count: int):
     line = line.rstrip()
     if len(line) > count * FIELD_WIDTH:
         return None
-    return [line[k * FIELD_WIDTH:(k + 1) * FIELD_WIDTH] for k in range(count)]
+    return fixed_fields(line, FIELD_WIDTH, count)
 
 
 def _header_numbers(lines, kind):
@@ -218,18 +213,17 @@ def _azimuth(component: str):
 
 def _start_time(ints, name: str, what: str) -> UTCDateTime:
     """Buffer start time (UT) from the integer header."""
-    try:
-        start = UTCDateTime(
-            ints[_I_BUFFER_YEAR], ints[_I_BUFFER_MONTH], ints[_I_BUFFER_DAY],
-            ints[_I_BUFFER_HOUR], ints[_I_BUFFER_MINUTE],
-        )
-    except Exception:  # noqa: BLE001 - any invalid date field
+    start = utc_time(
+        ints[_I_BUFFER_YEAR], ints[_I_BUFFER_MONTH], ints[_I_BUFFER_DAY],
+        ints[_I_BUFFER_HOUR], ints[_I_BUFFER_MINUTE],
+    )
+    if start is None:
         raise RecordError(
             name,
             f"{what}: the buffer start time in the integer header "
             f"({ints[_I_BUFFER_YEAR]}-{ints[_I_BUFFER_MONTH]}-{ints[_I_BUFFER_DAY]} "
             f"{ints[_I_BUFFER_HOUR]}:{ints[_I_BUFFER_MINUTE]}) is not a valid date",
-        ) from None
+        )
     milliseconds = ints[_I_BUFFER_MILLISECONDS]
     if not 0 <= milliseconds < 61000:
         raise RecordError(
@@ -325,13 +319,7 @@ def _block(lines, start: int, name: str, number: int, horizontal_index: int, hea
             f"{what}: the text says {stated_points.group(1)} points but the integer header says "
             f"{npts} acceleration samples",
         )
-    delta = check_delta(reals[_R_DELTA_S], name)
-    if not MIN_SAMPLING_INTERVAL_S <= delta <= MAX_SAMPLING_INTERVAL_S:
-        raise RecordError(
-            name,
-            f"{what}: sampling interval {delta:g} s is outside [{MIN_SAMPLING_INTERVAL_S:g}, "
-            f"{MAX_SAMPLING_INTERVAL_S:g}] s",
-        )
+    delta = check_sampling_interval(reals[_R_DELTA_S], name, f"{what}: sampling interval")
     stated_delta = next((m for m in map(_TEXT_DELTA_RE.search, text) if m), None)
     if stated_delta is not None and abs(float(stated_delta.group(1)) - delta) > TEXT_DELTA_TOLERANCE_S:
         raise RecordError(
@@ -419,13 +407,7 @@ def _block(lines, start: int, name: str, number: int, horizontal_index: int, hea
         samples = _parse_samples(lines, data_start, npts, name, what)
         check_samples(samples, name, what)
         trace = make_trace(samples * factor, delta, stats)
-        peak_si = float(np.max(np.abs(trace.data)))
-        if peak_si > MAX_ACCELERATION_SI:
-            raise RecordError(
-                name,
-                f"{what} has a sample of {peak_si:.3g} m/s^2, not a ground acceleration "
-                "(corrupt number or wrong unit?)",
-            )
+        check_plausible_samples(trace.data, name, what)
     trace.stats.starttime = buffer_start - prepended
     return trace, end
 

@@ -42,14 +42,15 @@ import math
 import re
 
 import numpy as np
-from obspy import Stream, UTCDateTime
+from obspy import Stream
 from obspy.core import AttribDict
 
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
-    check_delta,
+    check_plausible_samples,
     check_samples,
+    check_sampling_interval,
     make_trace,
     orientation_stats,
     parse_float,
@@ -57,6 +58,7 @@ from shipblock.io._common import (
     read_text,
     si_factor,
     source_name,
+    utc_time,
 )
 
 __all__ = ["FORMAT", "is_nsmn", "read_nsmn"]
@@ -69,14 +71,6 @@ NETWORK = "TK"
 
 #: First line of every NSMN file.
 _TITLE = "STRONG GROUND MOTION RECORDS OF TURKIYE"
-
-#: Largest absolute acceleration accepted as a ground motion [m/s^2] (100 g; the largest recorded
-#: ground accelerations are about 4 g): anything above is a corrupt number, not a record.
-MAX_ACCELERATION_SI = 980.665
-
-#: Range of sampling intervals accepted [s] (10 kHz to 1 Hz); outside it the header is corrupt.
-MIN_SAMPLING_INTERVAL_S = 1e-4
-MAX_SAMPLING_INTERVAL_S = 1.0
 
 #: The column names and what they mean: (vertical, azimuth [deg], index of a horizontal).
 _COLUMNS = {"N-S": (False, 0.0, 1), "E-W": (False, 90.0, 2), "U-D": (True, None, 1)}
@@ -164,10 +158,10 @@ def _start_time(raw: str, name: str):
         raise RecordError(name, f"RECORD TIME {raw!r} is not dd/mm/yyyy hh:mm:ss")
     day, month, year, hour, minute = (int(g) for g in match.groups()[:5])
     second = float(match.group(6))
-    try:
-        return UTCDateTime(year, month, day, hour, minute) + second
-    except Exception:  # noqa: BLE001 - obspy raises several types for impossible dates
-        raise RecordError(name, f"RECORD TIME {raw!r} is not a valid date and time") from None
+    start = utc_time(year, month, day, hour, minute, second)
+    if start is None:
+        raise RecordError(name, f"RECORD TIME {raw!r} is not a valid date and time")
+    return start
 
 
 def _coordinates(header, name):
@@ -271,11 +265,9 @@ def read_nsmn(filename, headonly: bool = False, **kwargs) -> Stream:
         raise RecordError(name, f"NUMBER OF DATA = {header['number_of_data']!r} is not a"
                                 " sample count")
     npts = int(npts)
-    delta = check_delta(_number(header, "sampling_interval_sec", name,
-                                "SAMPLING INTERVAL (sec)"), name)
-    if not MIN_SAMPLING_INTERVAL_S <= delta <= MAX_SAMPLING_INTERVAL_S:
-        raise RecordError(name, f"SAMPLING INTERVAL = {delta:g} s is outside"
-                                f" [{MIN_SAMPLING_INTERVAL_S:g}, {MAX_SAMPLING_INTERVAL_S:g}] s")
+    delta = check_sampling_interval(
+        _number(header, "sampling_interval_sec", name, "SAMPLING INTERVAL (sec)"), name,
+        "SAMPLING INTERVAL =")
     start = _start_time(header["record_time"], name) if "record_time" in header else None
     coordinates = _coordinates(header, name)
     station = header.get("station_id", "")
@@ -313,10 +305,7 @@ def read_nsmn(filename, headonly: bool = False, **kwargs) -> Stream:
             trace = make_trace(data[:, column_index], delta, stats)
             check_samples(trace.data, name, f"component {column}")
             trace.data *= factor
-            peak = float(np.max(np.abs(trace.data)))
-            if peak > MAX_ACCELERATION_SI:
-                raise RecordError(name, f"component {column} has a sample of {peak:.3g} m/s^2,"
-                                        " not a ground acceleration (corrupt number?)")
+            check_plausible_samples(trace.data, name, f"component {column}")
         if start is not None:
             trace.stats.starttime = start
         stream.append(trace)

@@ -62,7 +62,7 @@ References
 
 from __future__ import annotations
 
-import math
+import contextlib
 import re
 
 import numpy as np
@@ -72,14 +72,18 @@ from obspy.core import AttribDict
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     check_delta,
+    check_plausible_samples,
     check_samples,
+    fixed_fields,
     make_trace,
     orientation_stats,
     parse_float,
+    parse_number,
     peek_text,
     read_text,
     si_factor,
     source_name,
+    utc_time,
 )
 
 __all__ = ["FORMAT", "is_renadic", "read_renadic"]
@@ -104,9 +108,6 @@ FIELD_WIDTH = 7
 #: Largest difference between a stated sample time and ``i * dt`` [s]: the times are printed
 #: with three decimals.
 TIME_TOLERANCE_S = 1.5e-3
-
-#: Largest absolute acceleration accepted as a ground motion [m/s^2] (100 g).
-MAX_ACCELERATION_SI = 980.665
 
 #: Orientation labels: ``(vertical, azimuth [deg] or None)``.
 _ORIENTATIONS = {
@@ -162,26 +163,11 @@ def is_renadic(filename) -> bool:
 
 
 def _time(match):
-    """``UTCDateTime`` of a ``_DATE_TIME`` match, or ``None`` if impossible."""
+    """``UTCDateTime`` of a ``_DATE_TIME`` match, or ``None`` if absent or impossible."""
     if match is None:
         return None
     month, day, year, hour, minute = (int(match.group(i)) for i in range(1, 6))
-    second = float(match.group(6))
-    try:
-        return UTCDateTime(year, month, day, hour, minute) + second
-    except Exception:  # noqa: BLE001 - an impossible date is not a statement
-        return None
-
-
-def _number(raw, name, what):
-    """Parse one header number, finite, or raise a RecordError naming it."""
-    try:
-        value = parse_float(raw)
-    except ValueError:
-        raise RecordError(name, f"{what} {raw!r} is not a number") from None
-    if not math.isfinite(value):
-        raise RecordError(name, f"{what} {raw!r} is not a finite number")
-    return value
+    return utc_time(year, month, day, hour, minute, float(match.group(6)))
 
 
 def _unit_factor(unit, name):
@@ -207,30 +193,30 @@ def _block_header(text, name, number):
     counts = _NPTS_RE.search(text[10])
     if counts is None:
         raise RecordError(name, f"{where}: no 'NO. OF POINTS = n RECORD LENGTH = t SEC' line")
-    npts = _number(counts.group(1), name, f"{where}: NO. OF POINTS")
+    npts = parse_number(counts.group(1), name, f"{where}: NO. OF POINTS")
     if npts != int(npts) or npts <= 1:
         raise RecordError(name, f"{where}: NO. OF POINTS {counts.group(1)!r} is not a count")
     header["npts"] = int(npts)
-    header["record_length_s"] = _number(counts.group(2), name, f"{where}: RECORD LENGTH")
+    header["record_length_s"] = parse_number(counts.group(2), name,
+                                             f"{where}: RECORD LENGTH")
     units = _UNITS_RE.search(text[11])
     if units is None:
         raise UnitsError(name, f"{where}: the units line {text[11].strip()!r} is not understood")
     header["units"] = units.group(1)
     peak = _MAX_RE.search(text[11])
     if peak is not None:
-        header["stated_max_g"] = _number(peak.group(1), name, f"{where}: MAX")
-        header["stated_max_time_s"] = _number(peak.group(2), name, f"{where}: MAX time")
+        header["stated_max_g"] = parse_number(peak.group(1), name, f"{where}: MAX")
+        header["stated_max_time_s"] = parse_number(peak.group(2), name,
+                                                   f"{where}: MAX time")
     rms = _RMS_RE.search(text[12])
     if rms is not None:
-        header["stated_rms_g"] = _number(rms.group(1), name, f"{where}: RMS")
+        header["stated_rms_g"] = parse_number(rms.group(1), name, f"{where}: RMS")
     instrument = _INSTRUMENT_RE.search(text[9])
     if instrument is not None:
         for key, value in zip(("instrument_period_s", "instrument_damping",
-                               "sensitivity_v_per_g"), instrument.groups()):
-            try:
+                               "sensitivity_v_per_g"), instrument.groups(), strict=True):
+            with contextlib.suppress(ValueError):  # instrument constants are optional
                 header[key] = parse_float(value)
-            except ValueError:
-                pass
     station_line = text[5].strip()
     serial = _SERIAL_RE.search(station_line) or _SERIAL_RE.search(text[4])
     header["station_name"] = station_line.split("S/N")[0].strip()
@@ -261,7 +247,7 @@ def _parse_pairs(lines, name, where):
     fields = []
     for line in lines:
         text = line.rstrip()
-        fields.extend(text[i:i + FIELD_WIDTH] for i in range(0, len(text), FIELD_WIDTH))
+        fields.extend(fixed_fields(text, FIELD_WIDTH))
     try:
         values = np.array(fields, dtype=np.float64) if fields else np.empty(0)
     except ValueError:
@@ -391,10 +377,7 @@ def read_renadic(filename, headonly: bool = False, **kwargs) -> Stream:
             trace = make_trace(data, delta, stats)
             check_samples(trace.data, name, where)
             trace.data *= factor
-            peak = float(np.max(np.abs(trace.data)))
-            if peak > MAX_ACCELERATION_SI:
-                raise RecordError(name, f"{where} has a sample of {peak:.3g} m/s^2, not a ground"
-                                        " acceleration (corrupt number?)")
+            check_plausible_samples(trace.data, name, where)
         if first is not None:
             trace.stats.starttime = first
         stream.append(trace)

@@ -65,14 +65,18 @@ from obspy.core import AttribDict
 
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
+    DEFAULT_RESAMPLE_RATE_HZ,
     FLOAT_RE,
     check_delta,
     check_samples,
+    fixed_fields,
+    horizontal_index,
     make_trace,
     orientation_stats,
     parse_float,
     peek_text,
     read_text,
+    resample_pairs,
     si_factor,
     source_name,
 )
@@ -84,14 +88,6 @@ FORMAT = "SHIPBLOCK_SMC"
 
 #: Unit of SMC accelerations (the format's own; the header states no unit code).
 SMC_UNIT = "cm/s^2"
-
-#: Sampling rate onto which unevenly digitized records are interpolated [samples/s].
-DEFAULT_RESAMPLE_RATE_HZ = 200.0
-
-#: Longest gap between two digitized points bridged by interpolation [s]. The real files'
-#: largest gap is 0.037 s (SMC) and 0.013 s (USC); a quarter second without a point would hide
-#: the 1-25 Hz motion of the record, so a longer gap is taken for a corrupt time column.
-MAX_DIGITIZATION_GAP_S = 0.25
 
 #: Highest credible sampling rate [samples/s] (some files hold nonsense there).
 MAX_SAMPLING_RATE_HZ = 1.0e5
@@ -135,7 +131,7 @@ _COMPONENT_TEXT = re.compile(r"component\s*=\s*(\S+)", re.IGNORECASE)
 
 def _fixed_fields(line: str, width: int, count: int) -> list[str]:
     """Split a Fortran fixed-width line into at most ``count`` non-blank fields."""
-    fields = [line[i : i + width] for i in range(0, min(len(line), width * count), width)]
+    fields = fixed_fields(line[: width * count], width)
     while fields and not fields[-1].strip():
         fields.pop()
     return fields
@@ -222,86 +218,6 @@ def is_smc(filename) -> bool:
         return _looks_like_smc(text.splitlines()[:_HEADER_LINES])
     except Exception:  # noqa: BLE001 - detection must never raise
         return False
-
-
-def horizontal_index(azimuth_deg: float) -> int:
-    """SEED orientation digit of a horizontal that is not along north or east.
-
-    ``1`` for an axis nearer north-south (or exactly on a diagonal through the north-east
-    quadrant), ``2`` for one nearer east-west.
-
-    Parameters
-    ----------
-    azimuth_deg : float
-        Azimuth of the positive direction [deg clockwise from north].
-
-    Returns
-    -------
-    int
-        ``1`` or ``2``.
-    """
-    axis = azimuth_deg % 180.0
-    return 1 if axis <= 45.0 or axis > 135.0 else 2
-
-
-def resample_pairs(times, values, rate_hz: float, name: str):
-    """Interpolate unevenly digitized (time, value) pairs onto an even grid.
-
-    Parameters
-    ----------
-    times : numpy.ndarray
-        Digitized times [s], non-decreasing.
-    values : numpy.ndarray
-        Values at those times (any unit).
-    rate_hz : float
-        Sampling rate of the grid [samples/s].
-    name : str
-        File name, for error messages.
-
-    Returns
-    -------
-    tuple
-        ``(samples, first_time_s, merged)``: the samples at ``first_time_s + k / rate_hz`` up to
-        the last digitized time, the first digitized time [s], and how many repeated times were
-        merged (their values averaged).
-
-    Raises
-    ------
-    RecordError
-        If times go backwards, jump by more than :data:`MAX_DIGITIZATION_GAP_S`, are not finite,
-        or span no time.
-    """
-    times = np.asarray(times, dtype=np.float64)
-    values = np.asarray(values, dtype=np.float64)
-    if not (isinstance(rate_hz, (int, float)) and math.isfinite(rate_hz) and rate_hz > 0):
-        raise RecordError(name, f"resample rate {rate_hz!r} Hz is not a positive number")
-    if times.size < 2 or not np.all(np.isfinite(times)):
-        raise RecordError(name, "digitized times are missing or not finite")
-    steps = np.diff(times)
-    back = np.flatnonzero(steps < 0)
-    if back.size:
-        i = int(back[0])
-        raise RecordError(
-            name, f"digitized times go backwards at pair {i + 2} ({times[i]:g} s then"
-            f" {times[i + 1]:g} s)"
-        )
-    if steps.max() > MAX_DIGITIZATION_GAP_S:
-        i = int(np.argmax(steps))
-        raise RecordError(
-            name, f"digitized times jump by {steps[i]:g} s at pair {i + 2} (more than"
-            f" {MAX_DIGITIZATION_GAP_S:g} s; corrupt time column)"
-        )
-    unique, inverse = np.unique(times, return_inverse=True)
-    if unique.size < 2:
-        raise RecordError(name, "digitized times span no time")
-    merged = times.size - unique.size
-    if merged:
-        values = np.bincount(inverse, weights=values) / np.bincount(inverse)
-    span = unique[-1] - unique[0]
-    # The small allowance keeps a last digitized time that falls on the grid.
-    count = int(math.floor(span * rate_hz + 1e-6)) + 1
-    grid = unique[0] + np.arange(count) / rate_hz
-    return np.interp(grid, unique, values), float(unique[0]), merged
 
 
 def _null(value, null) -> bool:

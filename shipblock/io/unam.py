@@ -55,21 +55,25 @@ import re
 import unicodedata
 
 import numpy as np
-from obspy import Stream, UTCDateTime
+from obspy import Stream
 from obspy.core import AttribDict
 
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
     check_delta,
+    check_plausible_samples,
     check_samples,
+    fixed_fields,
     make_trace,
     orientation_stats,
     parse_float,
+    parse_number,
     peek_text,
     read_text,
     si_factor,
     source_name,
+    utc_time,
 )
 
 __all__ = ["FORMAT", "is_unam", "read_unam"]
@@ -82,10 +86,6 @@ _TITLE = "ARCHIVO ESTANDAR DE ACELERACION"
 
 #: Marker of the data section.
 _DATA_TITLE = "DATOS DE ACELERACION"
-
-#: Largest absolute acceleration accepted as a ground motion [m/s^2] (100 g; the largest recorded
-#: ground accelerations are about 4 g): anything above is a corrupt number, not a record.
-MAX_ACCELERATION_SI = 980.665
 
 #: Largest distance [s] between the record start and the origin time for which the earthquake's
 #: date is trusted without trying the day before and after (half a day).
@@ -186,17 +186,6 @@ def _per_channel(header, prefix, exclude=None):
     return result
 
 
-def _number(raw, name, what):
-    """Parse one header number or raise a RecordError naming it."""
-    try:
-        value = parse_float(raw)
-    except ValueError:
-        raise RecordError(name, f"{what} {raw!r} is not a number") from None
-    if not math.isfinite(value):
-        raise RecordError(name, f"{what} {raw!r} is not a finite number")
-    return value
-
-
 def _orientation(label):
     """``(vertical, azimuth [deg] or None)`` of an orientation label such as ``N90W`` or ``V``."""
     text = label.split(";")[0].strip().upper().replace(" ", "")
@@ -275,10 +264,7 @@ def _date(raw):
         return None
     numbers = [int(part) for part in parts]
     year, month, day = numbers if len(parts[0]) == 4 else numbers[::-1]
-    try:
-        return UTCDateTime(year, month, day)
-    except Exception:  # noqa: BLE001 - an impossible date is simply not a statement
-        return None
+    return utc_time(year, month, day)
 
 
 def _start_time(header):
@@ -330,7 +316,7 @@ def _parse_rows(lines, nchan, fmt, name):
         if len(tokens) != nchan and width is not None:
             # Fixed-width fields can touch when a value fills its field (-1234.5678-123.4567).
             text = line.rstrip()
-            tokens = [text[i * width:(i + 1) * width].strip() for i in range(nchan)]
+            tokens = [field.strip() for field in fixed_fields(text, width, nchan)]
             if len(text) > nchan * width:
                 tokens.append(text[nchan * width:])
         if len(tokens) != nchan:
@@ -413,7 +399,7 @@ def read_unam(filename, headonly: bool = False, **kwargs) -> Stream:
 
     orientations = _per_channel(header, "ORIENTACION")
     count_text = _first(header, "NUMERO DE CANALES")
-    nchan = int(_number(count_text, name, "NUMERO DE CANALES")) if count_text else len(
+    nchan = int(parse_number(count_text, name, "NUMERO DE CANALES")) if count_text else len(
         orientations)
     if not 1 <= nchan <= 12:
         raise RecordError(name, f"NUMERO DE CANALES={count_text!r} is not 1 to 12")
@@ -428,7 +414,7 @@ def read_unam(filename, headonly: bool = False, **kwargs) -> Stream:
         raise RecordError(name, "NUM. TOTAL DE MUESTRAS does not give every channel's count")
     npts = []
     for value in npts_text[:nchan]:
-        count = _number(value, name, "NUM. TOTAL DE MUESTRAS")
+        count = parse_number(value, name, "NUM. TOTAL DE MUESTRAS")
         if count != int(count) or count <= 0:
             raise RecordError(name, f"NUM. TOTAL DE MUESTRAS {value!r} is not a sample count")
         npts.append(int(count))
@@ -436,9 +422,9 @@ def read_unam(filename, headonly: bool = False, **kwargs) -> Stream:
     for channel in range(nchan):
         delta_raw = deltas_text[channel] if channel < len(deltas_text) else ""
         rate_raw = rates_text[channel] if channel < len(rates_text) else ""
-        rate = _number(rate_raw, name, "VEL. DE MUESTREO") if rate_raw else None
+        rate = parse_number(rate_raw, name, "VEL. DE MUESTREO") if rate_raw else None
         if delta_raw:
-            delta = check_delta(_number(delta_raw, name, "INTERVALO DE MUESTREO"), name)
+            delta = check_delta(parse_number(delta_raw, name, "INTERVALO DE MUESTREO"), name)
             if rate is not None and abs(rate * delta - 1.0) > _RATE_TOLERANCE:
                 raise RecordError(name, f"channel {channel + 1}: sampling interval {delta} s"
                                         f" and sampling rate {rate} /s disagree")
@@ -500,10 +486,7 @@ def read_unam(filename, headonly: bool = False, **kwargs) -> Stream:
             trace = make_trace(column[:npts[channel]], deltas[channel], stats)
             check_samples(trace.data, name, what)
             trace.data *= factor
-            peak = float(np.max(np.abs(trace.data)))
-            if peak > MAX_ACCELERATION_SI:
-                raise RecordError(name, f"{what} has a sample of {peak:.3g} m/s^2, not a ground"
-                                        " acceleration (corrupt number?)")
+            check_plausible_samples(trace.data, name, what)
         if start is not None:
             trace.stats.starttime = start
         stream.append(trace)

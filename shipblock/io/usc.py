@@ -68,19 +68,22 @@ from obspy.core import AttribDict
 
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
+    DEFAULT_RESAMPLE_RATE_HZ,
     FLOAT_RE,
     canonical_unit,
     check_delta,
     check_samples,
+    fixed_fields,
+    horizontal_index,
     make_trace,
     orientation_stats,
     parse_float,
     peek_text,
     read_text,
+    resample_pairs,
     si_factor,
     source_name,
 )
-from shipblock.io.smc import DEFAULT_RESAMPLE_RATE_HZ, horizontal_index, resample_pairs
 from shipblock.units import STANDARD_GRAVITY
 
 __all__ = ["FORMAT", "is_usc", "read_usc"]
@@ -168,9 +171,7 @@ def _fixed(lines, width, count, what, first_lineno, name, cast):
     """Parse ``count`` fixed-width numbers from ``lines``; raise :class:`RecordError` if bad."""
     values = []
     for offset, line in enumerate(lines):
-        line = line.rstrip()
-        for start in range(0, len(line), width):
-            field = line[start : start + width]
+        for field in fixed_fields(line.rstrip(), width):
             try:
                 values.append(cast(field))
             except ValueError:
@@ -304,7 +305,7 @@ def _v1_pairs(lines, start, npairs, name):
     values = []
     for offset, line in enumerate(block):
         line = line.rstrip()
-        fields = [line[:8]] + [line[i : i + 7] for i in range(8, len(line), 7)]
+        fields = [line[:8]] + fixed_fields(line[8:], 7)
         for field in fields:
             try:
                 values.append(_float_field(field))
@@ -406,14 +407,12 @@ def _read_v2(lines, start, name, headonly):
                                 f" ends after {len(block)} of their {nlines} lines")
     values = []
     for offset, line in enumerate(block):
-        line = line.rstrip()
-        for i in range(0, len(line), _REAL_WIDTH):
+        for field in fixed_fields(line.rstrip(), _REAL_WIDTH):
             try:
-                values.append(_float_field(line[i : i + _REAL_WIDTH]))
+                values.append(_float_field(field))
             except ValueError:
                 raise RecordError(
-                    name, f"data line {acc_at + 2 + offset}: {line[i:i + _REAL_WIDTH].strip()!r}"
-                    " is not a number"
+                    name, f"data line {acc_at + 2 + offset}: {field.strip()!r} is not a number"
                 ) from None
     if len(values) != npts:
         raise RecordError(name, f"{npts} acceleration samples stated but {len(values)} found in"

@@ -1,26 +1,53 @@
-"""Read every file of the gmprocess test corpus with gmprocess's own readers; print a CSV of peaks."""
-import csv, sys, os, glob, warnings, logging
+"""Write the reference table of gmprocess's readings of the real corpus (not a test).
+
+Reads every file of the named corpus folders with gmprocess's own readers
+(``gmprocess.io.read.read_data``; RENADIC asked for by name) and prints one CSV row per trace:
+file, trace id, npts, delta, start time, peak |x| and gmprocess's units; a file gmprocess refuses
+gets one ``ERROR`` row with the exception. ``tests/data/reference/gmprocess_2.8_peaks.csv`` was
+made so, with gmprocess 2.8.0 (obspy 1.5.1) in a virtual environment of its own:
+
+    python gmprocess_reference_peaks.py <testdata folder> bhrc,cosmos,csn,... > peaks.csv
+"""
+
+import csv
+import glob
+import logging
+import os
+import sys
+import warnings
+
 import numpy as np
-logging.disable(logging.CRITICAL)
-warnings.simplefilter("ignore")
-from gmprocess.io.read import read_data
-root = sys.argv[1]
-fmts = sys.argv[2].split(",")
-w = csv.writer(sys.stdout)
-w.writerow(["format", "file", "trace_id", "npts", "delta_s", "starttime", "peak_abs", "units", "units_type"])
-for fmt in fmts:
-    for path in sorted(glob.glob(f"{root}/{fmt}/**/*", recursive=True)):
-        if os.path.isdir(path) or path.endswith((".json", ".yml", ".xml", ".zip")):
-            continue
-        rel = os.path.relpath(path, root)
-        try:
-            streams = read_data(path, read_format=('renadic' if fmt=='renadic' else None))
-        except (Exception, BaseException) as exc:
-            w.writerow([fmt, rel, "ERROR", "", "", "", "", type(exc).__name__, str(exc)[:120].replace("\n", " ")])
-            continue
-        for st in streams:
-            for tr in st:
-                std = tr.stats.get("standard", {})
-                w.writerow([fmt, rel, tr.id, tr.stats.npts, repr(float(tr.stats.delta)), str(tr.stats.starttime),
-                            repr(float(np.max(np.abs(tr.data)))), std.get("units", ""), std.get("units_type", "")])
-        sys.stdout.flush()
+
+
+def main(root: str, folders: list[str]) -> None:
+    logging.disable(logging.CRITICAL)
+    warnings.simplefilter("ignore")
+    from gmprocess.io.read import read_data
+
+    out = csv.writer(sys.stdout)
+    out.writerow(["format", "file", "trace_id", "npts", "delta_s", "starttime", "peak_abs",
+                  "units", "units_type"])
+    for folder in folders:
+        for path in sorted(glob.glob(f"{root}/{folder}/**/*", recursive=True)):
+            if os.path.isdir(path) or path.endswith((".json", ".yml", ".xml", ".zip")):
+                continue
+            rel = os.path.relpath(path, root)
+            try:
+                streams = read_data(path, read_format="renadic" if folder == "renadic" else None)
+            except BaseException as exc:  # noqa: BLE001 - gmprocess raises BaseException too
+                if isinstance(exc, KeyboardInterrupt):
+                    raise
+                out.writerow([folder, rel, "ERROR", "", "", "", "", type(exc).__name__,
+                              str(exc)[:120].replace("\n", " ")])
+                continue
+            for stream in streams:
+                for trace in stream:
+                    standard = trace.stats.get("standard", {})
+                    out.writerow([folder, rel, trace.id, trace.stats.npts,
+                                  repr(float(trace.stats.delta)), str(trace.stats.starttime),
+                                  repr(float(np.max(np.abs(trace.data)))),
+                                  standard.get("units", ""), standard.get("units_type", "")])
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2].split(","))
