@@ -34,7 +34,7 @@ import numpy as np
 import obspy
 from obspy import Stream, Trace, UTCDateTime
 
-from shipblock.errors import ParameterError, RecordError, ShipblockError, UnitsError
+from shipblock.errors import ParameterError, RecordError, UnitsError
 from shipblock.io import read_record
 from shipblock.io._common import canonical_unit, si_factor
 from shipblock.units import STANDARD_GRAVITY, VELOCITY_UNITS_TO_SI
@@ -1200,11 +1200,10 @@ def read_motion(
                 trace, inv, inventory_name, units, response, differentiate
             )
         _check_finite(trace)
-    for component, trace in assigned.items():
-        site = trace.stats.get("sensor_site")
-        if site in SITE_NOTES:
-            notes.append(f"{component} ({trace.id}): {SITE_NOTES[site]}")
-            logger.warning("%s: %s", label, notes[-1])
+    sites = {trace.stats.get("sensor_site") for trace in assigned.values()} & set(SITE_NOTES)
+    for site in sorted(sites):
+        notes.append(SITE_NOTES[site])
+        logger.warning("%s: %s", label, notes[-1])
     if "V" in assigned:
         mean = float(np.mean(assigned["V"].data))
         if abs(mean) > GRAVITY_NOTE_THRESHOLD:
