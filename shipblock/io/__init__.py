@@ -4,23 +4,23 @@ Formats obspy already reads (MiniSEED, SAC, K-NET, Kinemetrics EVT, ...) go stra
 :func:`obspy.read`. Formats obspy lacks are obspy waveform plug-ins registered through entry points
 by shipblock's ``pyproject.toml`` (so ``obspy.read("x.AT2")`` works once shipblock is installed):
 
-================  =================================  ==========================================
-format            module                             what
-================  =================================  ==========================================
-SHIPBLOCK_AT2     :mod:`shipblock.io.at2`            PEER NGA ``.AT2`` (g)
-SHIPBLOCK_COSMOS  :mod:`shipblock.io.cosmos`         COSMOS / CSMIP V1 and V2 (unit codes)
-SHIPBLOCK_ESM     :mod:`shipblock.io.esm`            ESM ASCII (``UNITS`` key)
-SHIPBLOCK_DMG     :mod:`shipblock.io.dmg`            CSMIP/CDMG V1, V2 and RAW (CESMD)
-SHIPBLOCK_GEONET  :mod:`shipblock.io.geonet`         GeoNet V1A/V2A (New Zealand)
-SHIPBLOCK_CWB     :mod:`shipblock.io.cwb`            CWB (Taiwan) ``.dat``
-SHIPBLOCK_NSMN    :mod:`shipblock.io.nsmn`           AFAD/NSMN text (Turkey)
-SHIPBLOCK_BHRC    :mod:`shipblock.io.bhrc`           BHRC V1 (Iran)
-SHIPBLOCK_UNAM    :mod:`shipblock.io.unam`           UNAM ASA (Mexico)
-SHIPBLOCK_RENADIC :mod:`shipblock.io.renadic`        RENADIC ``.v1`` (Chile)
-SHIPBLOCK_USC     :mod:`shipblock.io.usc`            USC volumes (Los Angeles)
-SHIPBLOCK_SMC     :mod:`shipblock.io.smc`            USGS SMC
-SHIPBLOCK_TEXT    :mod:`shipblock.io.text`           one/two-column text or CSV (stated units)
-================  =================================  ==========================================
+==================  =================================  ==========================================
+format              module                             what
+==================  =================================  ==========================================
+SHIPBLOCK_AT2       :mod:`shipblock.io.at2`            PEER NGA ``.AT2`` (g)
+SHIPBLOCK_COSMOS    :mod:`shipblock.io.cosmos`         COSMOS / CSMIP V1 and V2 (unit codes)
+SHIPBLOCK_ESM       :mod:`shipblock.io.esm`            ESM ASCII (``UNITS`` key)
+SHIPBLOCK_DMG       :mod:`shipblock.io.dmg`            CSMIP/CDMG V1, V2 and RAW (CESMD)
+SHIPBLOCK_GEONET    :mod:`shipblock.io.geonet`         GeoNet V1A/V2A (New Zealand)
+SHIPBLOCK_CWB       :mod:`shipblock.io.cwb`            CWB (Taiwan) ``.dat``
+SHIPBLOCK_NSMN      :mod:`shipblock.io.nsmn`           AFAD/NSMN text (Turkey)
+SHIPBLOCK_BHRC      :mod:`shipblock.io.bhrc`           BHRC V1 (Iran)
+SHIPBLOCK_UNAM      :mod:`shipblock.io.unam`           UNAM ASA (Mexico)
+SHIPBLOCK_RENADIC   :mod:`shipblock.io.renadic`        RENADIC ``.v1`` (Chile)
+SHIPBLOCK_USC       :mod:`shipblock.io.usc`            USC volumes (Los Angeles)
+SHIPBLOCK_SMC       :mod:`shipblock.io.smc`            USGS SMC
+SHIPBLOCK_TEXT      :mod:`shipblock.io.text`           one/two-column text or CSV (stated units)
+==================  =================================  ==========================================
 
 K-NET and KiK-net files are read by obspy and renamed the SEED way by
 :func:`shipblock.io.knet.normalise_knet`.
