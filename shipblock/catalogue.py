@@ -221,22 +221,29 @@ def _relative(path, base: Path) -> str:
     return Path(os.path.relpath(Path(path).resolve(), base)).as_posix()
 
 
-def _inventory_file(motion, inventories) -> Path | None:
-    """The StationXML file among ``inventories`` that holds the motion's station."""
+def _station_inventories(paths) -> dict[Path, object]:
+    """Each StationXML file parsed once: path -> obspy Inventory (unreadable files left out)."""
     import warnings
 
     import obspy
 
-    station = motion.metadata.get("station") or {}
-    for path in inventories:
+    parsed = {}
+    for path in paths:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                inventory = obspy.read_inventory(str(path))
+                parsed[Path(path)] = obspy.read_inventory(str(path))
         except Exception:  # noqa: BLE001 - read_motions already reported it
             continue
+    return parsed
+
+
+def _inventory_file(motion, inventories: dict) -> Path | None:
+    """The StationXML file among the parsed ``inventories`` that holds the motion's station."""
+    station = motion.metadata.get("station") or {}
+    for path, inventory in inventories.items():
         if len(inventory.select(network=station.get("network"), station=station.get("station"))):
-            return Path(path)
+            return path
     return None
 
 
@@ -273,7 +280,7 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
     from shipblock.units import STANDARD_GRAVITY
 
     base = Path(output).resolve().parent
-    inventories = [Path(p) for p in motions.skipped if p.lower().endswith(".xml")]
+    inventories = _station_inventories(p for p in motions.skipped if p.lower().endswith(".xml"))
     lines = [
         "# Record catalogue written by 'shipblock catalogue'. One [[record]] table per station",
         "# sensor; paths are relative to this file. pga_* are peaks of the records as read (before",

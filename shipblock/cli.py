@@ -74,6 +74,8 @@ def _add_record_arguments(p):
     g.add_argument("--record", help="id of a catalogue record, e.g. NP.1765 or south-napa-2014/NP.1765")
     g.add_argument("--catalogue", help="record catalogue TOML (default: the shipped one)")
     _add_conversion_arguments(g)
+    g.add_argument("--sensor", help="sensor to use when a station has several: LOC.CODE, e.g."
+                                    " 02.HN (KiK-net surface) or HN")
     g.add_argument("--azimuth", type=float,
                    help="dock transverse axis [deg clockwise from north]: horizontals rotated to it")
     g.add_argument("--horizontal", choices=["H1", "H2"], help="use this horizontal component")
@@ -91,8 +93,6 @@ def _add_conversion_arguments(g):
                         " the full instrument response")
     g.add_argument("--differentiate", action="store_true",
                    help="differentiate velocity records to acceleration (said in the provenance)")
-    g.add_argument("--sensor", help="sensor to use when a station has several: LOC.CODE, e.g."
-                                    " 02.HN (KiK-net surface) or HN")
 
 
 def _conversion_kwargs(args) -> dict:
@@ -374,8 +374,12 @@ def cmd_catalogue(args):
     output.parent.mkdir(parents=True, exist_ok=True)
     partial = output.with_name(output.name + ".part")
     partial.write_text(text)
+    try:
+        load_catalogue(partial)  # what is written reads back (paths resolve in the same folder)
+    except Exception:
+        partial.unlink()
+        raise
     partial.replace(output)
-    load_catalogue(output)  # what was written reads back
     sys.stdout.write(f"{len(found.motions)} records written to {output}; "
                      f"{len(found.failures)} files or groups not used\n")
     for motion in found.motions:

@@ -36,8 +36,8 @@ from obspy import Stream, Trace, UTCDateTime
 
 from shipblock.errors import ParameterError, RecordError, UnitsError
 from shipblock.io import read_record
-from shipblock.io._common import canonical_unit, si_factor
-from shipblock.units import STANDARD_GRAVITY, VELOCITY_UNITS_TO_SI
+from shipblock.io._common import canonical_unit, canonical_velocity_unit, si_factor
+from shipblock.units import ACCELERATION_UNITS_TO_SI, STANDARD_GRAVITY, VELOCITY_UNITS_TO_SI
 
 __all__ = [
     "COMPONENTS",
@@ -77,19 +77,6 @@ SAMPLE_FRACTION_TOLERANCE = 1e-3
 CALIB_IN_SI_FORMATS = {
     "KNET": "K-NET scale factor",
     "KINEMETRICS_EVT": "Kinemetrics EVT full scale and sensitivity",
-}
-
-#: Input units of a StationXML response (upper case, no blanks) -> (quantity, factor to SI).
-INPUT_UNITS_TO_SI: dict[str, tuple[str, float]] = {
-    **{u: ("acceleration", 1.0) for u in ("M/S**2", "M/S^2", "M/S/S", "M/S2", "M/(S**2)", "M/SEC**2")},
-    **{u: ("acceleration", 1e-2) for u in ("CM/S**2", "CM/S^2", "CM/S/S", "CM/S2", "GAL")},
-    **{u: ("acceleration", 1e-3) for u in ("MM/S**2", "MM/S^2", "MM/S/S", "MM/S2")},
-    **{u: ("acceleration", 1e-9) for u in ("NM/S**2", "NM/S^2", "NM/S/S", "NM/S2")},
-    **{u: ("acceleration", STANDARD_GRAVITY) for u in ("G", "GS")},
-    **{u: ("velocity", 1.0) for u in ("M/S", "M/SEC")},
-    **{u: ("velocity", 1e-2) for u in ("CM/S", "CM/SEC")},
-    **{u: ("velocity", 1e-3) for u in ("MM/S", "MM/SEC")},
-    **{u: ("velocity", 1e-9) for u in ("NM/S", "NM/SEC")},
 }
 
 #: SAC's dependent-variable codes (IDEP) that state a unit, and the unit (SAC manual: IACC is
@@ -315,9 +302,12 @@ def _select_channel(trace: Trace, inventory, inventory_name):
 
 def _input_unit(unit: str | None):
     """``(quantity, factor to SI)`` of a StationXML/SAC input unit, or ``(None, None)``."""
-    key = (unit or "").strip().upper().replace(" ", "")
-    if key in INPUT_UNITS_TO_SI:
-        return INPUT_UNITS_TO_SI[key]
+    acceleration = canonical_unit(unit or "")
+    if acceleration is not None:
+        return "acceleration", ACCELERATION_UNITS_TO_SI[acceleration]
+    velocity = canonical_velocity_unit(unit)
+    if velocity is not None:
+        return "velocity", VELOCITY_UNITS_TO_SI[velocity]
     return None, None
 
 
@@ -400,17 +390,12 @@ def _sac_unit(trace: Trace) -> tuple[str | None, str]:
     sac = trace.stats.get("sac") or {}
     for key in ("kuser0", "kuser1", "kuser2"):
         word = str(sac.get(key, "") or "").strip()
-        if word and word != "-12345" and (canonical_unit(word) or _velocity_unit(word)):
+        if word and word != "-12345" and (canonical_unit(word) or canonical_velocity_unit(word)):
             return word, f"SAC {key.upper()}={word!r}"
     idep = sac.get("idep")
     if idep in SAC_IDEP_UNITS:
         return SAC_IDEP_UNITS[idep], f"SAC IDEP={idep} ({SAC_IDEP_NAMES[idep]})"
     return None, ""
-
-
-def _velocity_unit(unit: str | None) -> str | None:
-    key = (unit or "").strip().lower().replace(" ", "").replace("sec", "s")
-    return key if key in VELOCITY_UNITS_TO_SI else None
 
 
 def _check_gravity(trace: Trace, unit: str, origin: str, name: str) -> None:
@@ -485,7 +470,7 @@ def _to_si(trace: Trace, inventory, inventory_name, units, response, differentia
             data = data * stats.calib
             prefix = f"calib {stats.calib:g} from the {fmt or 'stream'} header, then "
             stats.calib = 1.0
-        velocity = _velocity_unit(units)
+        velocity = canonical_velocity_unit(units)
         if velocity is not None:
             factor = VELOCITY_UNITS_TO_SI[velocity]
             trace.data = data * factor
@@ -570,8 +555,11 @@ def sensor_code(trace: Trace) -> str:
     return f"{trace.stats.location}.{code}"
 
 
-def _select_sensor(stream: Stream, sensor: str | None, channel_map) -> Stream:
-    """Keep the traces of one sensor; refuse a choice between several that nobody made."""
+def _select_sensor(stream: Stream, sensor: str | None, channel_map, strict: bool = True) -> Stream:
+    """Keep the traces of one sensor; refuse a choice between several that nobody made.
+
+    With ``strict=False`` a sensor that matches nothing gives an empty Stream, not an error.
+    """
     sensors = dict.fromkeys(sensor_code(tr) for tr in stream)
     if sensor is None:
         if len(sensors) <= 1 or channel_map:
@@ -590,7 +578,7 @@ def _select_sensor(stream: Stream, sensor: str | None, channel_map) -> Stream:
     wanted = sensor.strip().upper()
     chosen = Stream([tr for tr in stream if sensor_code(tr).upper() == wanted
                      or ("." not in wanted and tr.stats.channel[:2].upper() == wanted)])
-    if not chosen:
+    if not chosen and strict:
         raise ParameterError(
             f"sensor={sensor!r} matches none of the record's sensors: {', '.join(sensors)}"
         )
@@ -1068,25 +1056,29 @@ def _names_many(source) -> bool:
 
 
 def _one_of_folder(source, inventory, units, response, differentiate, align, gaps, event,
-                   azimuth, horizontal) -> GroundMotion:
-    """The single record of a folder or glob; refuse a folder of several."""
+                   azimuth, horizontal, sensor) -> GroundMotion:
+    """The single record (of ``sensor``, if given) of a folder or glob; refuse several."""
     from shipblock.collection import read_motions
 
     found = read_motions(source, inventory=inventory, units=units, response=response,
                          differentiate=differentiate, align=align, gaps=gaps, event=event)
+    motions = found.motions
+    if sensor is not None:
+        motions = [m for m in motions if len(_select_sensor(m.stream, sensor, None, strict=False))]
     label = os.fspath(source)
     failures = "".join(f"\n  {where}: {why}" for where, why in found.failures)
-    if not found.motions:
-        raise RecordError(label, "no record could be read from it:" + failures)
-    if len(found) > 1:
+    if not motions:
+        raise RecordError(label, "no record could be read from it"
+                          + (f" for sensor {sensor!r}" if sensor else "") + ":" + failures)
+    if len(motions) > 1:
         raise RecordError(
             label,
-            f"holds {len(found)} records ("
-            + ", ".join(m.name for m in found.motions)
-            + "); read_motions() (command line: shipblock catalogue) reads them all; name the"
-            " files of one" + failures,
+            f"holds {len(motions)} records ("
+            + ", ".join(next(iter(m.metadata["channels"].values()))[:-1] for m in motions)
+            + "); choose one with sensor= (command line: --sensor) or name its files;"
+            " read_motions() (command line: shipblock catalogue) reads them all" + failures,
         )
-    motion = found.motions[0]
+    motion = motions[0]
     if azimuth is not None or horizontal is not None:
         metadata = dict(motion.metadata)
         metadata["horizontal"] = (f"projected on azimuth {azimuth:g} deg" if azimuth is not None
@@ -1177,7 +1169,7 @@ def read_motion(
         raise ParameterError(f"align must be 'trim' or 'strict', not {align!r}")
     if _names_many(paths_or_stream):
         return _one_of_folder(paths_or_stream, inventory, units, response, differentiate, align,
-                              gaps, event, azimuth, horizontal)
+                              gaps, event, azimuth, horizontal, sensor)
     stream = _load_stream(paths_or_stream, units, format, read_kwargs)
     label = ", ".join(dict.fromkeys(_source(tr) for tr in stream)) or "<stream>"
     if len(stream) == 0:

@@ -310,3 +310,14 @@ _FOLDER_FILES = {
                            "nc73631381_ad") for s in ("..HNE.mseed", "..HNN.mseed", "..HNZ.mseed",
                                                       ".xml")],
 }
+
+
+def test_folder_sensor_flag_picks_one_record(tmp_path):
+    names = [f"kiknet/usp000hzq8/NGNH351106302345.{d}{k}" for d in ("NS", "EW", "UD") for k in "12"]
+    _copy(names, tmp_path)
+    with pytest.raises(RecordError, match="holds 2 records.*--sensor"):
+        read_motion(tmp_path)
+    surface = read_motion(tmp_path, sensor="02.HN")
+    assert surface.metadata["channels"]["V"] == "BO.NGNH35.02.HNZ"
+    with pytest.raises(RecordError, match="for sensor '03.HN'"):
+        read_motion(tmp_path, sensor="03.HN")

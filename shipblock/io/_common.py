@@ -16,7 +16,7 @@ import numpy as np
 from obspy import Trace, UTCDateTime
 
 from shipblock.errors import RecordError, UnitsError
-from shipblock.units import ACCELERATION_UNITS_TO_SI
+from shipblock.units import ACCELERATION_UNITS_TO_SI, VELOCITY_UNITS_TO_SI
 
 #: Number of bytes read by the format-detection functions [bytes].
 PEEK_BYTES = 8192
@@ -77,6 +77,8 @@ UNIT_ALIASES: dict[str, str] = {
     "nm/s**2": "nm/s^2",
     "nm/s/s": "nm/s^2",
     "nm/s2": "nm/s^2",
+    "m/(s**2)": "m/s^2",
+    "m/sec**2": "m/s^2",
 }
 
 
@@ -296,6 +298,13 @@ def canonical_unit(unit: str) -> str | None:
     key = unit.strip().lower().replace(" ", "")
     key = UNIT_ALIASES.get(key, key)
     return key if key in ACCELERATION_UNITS_TO_SI else None
+
+
+def canonical_velocity_unit(unit: str | None) -> str | None:
+    """Map a spelling of a velocity unit (``"M/S"``, ``"cm/sec"``) to a key of
+    :data:`shipblock.units.VELOCITY_UNITS_TO_SI`, or ``None`` if it is not one."""
+    key = (unit or "").strip().lower().replace(" ", "").replace("sec", "s")
+    return key if key in VELOCITY_UNITS_TO_SI else None
 
 
 def si_factor(unit: str, name: str) -> float:
