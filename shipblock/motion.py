@@ -518,7 +518,9 @@ def _to_si(trace: Trace, inventory, inventory_name, units, response, differentia
     current = stats.get("units")
     if current == _SI_UNITS:
         original = stats.get("original_units", _SI_UNITS)
-        if units is not None and si_factor(units, name) != si_factor(original, name):
+        key = canonical_unit(str(original))
+        if units is not None and (key is None or si_factor(units, name)
+                                  != ACCELERATION_UNITS_TO_SI[key]):
             raise UnitsError(name, f"units={units!r} contradicts the file's own unit {original!r}")
         return f"{original} -> m/s**2 from the file header ({fmt or 'stream'})"
     if current == "m/s" and units is None:
