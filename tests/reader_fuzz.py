@@ -4,7 +4,12 @@
 line dropped, numbers replaced by NaN/inf/huge/negative values or garbage, lines duplicated,
 bytes flipped); :func:`assert_reader_survives` feeds each to a reader and asserts that it either
 raises one of shipblock's own errors (which name the file) or returns only finite samples at a
-finite positive sampling interval. An IndexError, a hang or a silently wrong stream fails.
+sampling interval within 1e-4..1 s, accelerations under 100 g. An IndexError, a hang or a
+silently wrong stream fails.
+
+:func:`sac_patch` and :func:`stationxml_patch` change one header field of a SAC or StationXML file
+(the cases of :func:`sac_field_mutations` and :func:`stationxml_field_mutations`), for the tests
+of ``tests/test_reader_fuzz_headers.py``, which know the correct read of each.
 """
 
 from __future__ import annotations
@@ -85,6 +90,10 @@ def assert_reader_survives(reader, raw: bytes, seed: int = 0, count: int = 60, *
             assert trace.stats.npts > 0, description
             assert np.all(np.isfinite(trace.data)), description
             assert math.isfinite(trace.stats.delta) and trace.stats.delta > 0, description
+            # The shared plausibility limits (shipblock.io._common): 1e-4..1 s, under 100 g.
+            assert 1e-4 <= trace.stats.delta <= 1.0, (description, trace.stats.delta)
+            if trace.stats.get("units") == "m/s**2":
+                assert np.max(np.abs(trace.data)) <= 100 * 9.80665, description
         read += 1
     return read
 

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import io
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -199,3 +200,33 @@ def test_negative_sensitivity_is_polarity_not_damage(tmp_path, napa_reference):
 @given(value=st.floats(allow_nan=True, allow_infinity=True))
 def test_stationxml_sensitivity_drawn(tmp_path, napa_reference, value):
     _check_xml(tmp_path, "Value", repr(value), napa_reference)
+
+
+# ------------------------------------------------------------- obspy's formats through read_record
+
+
+@pytest.mark.parametrize("kind", ["knet", "sac", "mseed"])
+def test_obspy_formats_survive_mutations_through_read_record(tmp_path, kind):
+    """Mutated K-NET (obspy's test file), SAC (made above) and MiniSEED (NP.1737) files, read by
+    :func:`shipblock.io.read_record`: a project error, or finite samples at 1e-4..1 s. A K-NET
+    sample replaced by 1e999 was read as inf counts before."""
+    import obspy
+
+    from shipblock.io import read_record
+    from tests.reader_fuzz import assert_reader_survives
+
+    raw = {
+        "knet": lambda: (Path(obspy.__file__).parent / "io" / "nied" / "tests" / "data"
+                         / "test.knet").read_bytes(),
+        "sac": _sac_bytes,
+        "mseed": lambda: (NAPA / "NP.1737.mseed").read_bytes(),
+    }[kind]()
+    path = tmp_path / f"fuzz.{kind}"
+
+    def read(fileobj):
+        path.write_bytes(fileobj.read())
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return read_record(path)
+
+    assert assert_reader_survives(read, raw, seed=23, count=40) > 0

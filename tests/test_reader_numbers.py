@@ -164,3 +164,23 @@ def test_text_absurd_interval_and_samples_refused(tmp_path):
     with pytest.raises(RecordError, match=r"big\.txt: the acceleration column \(in g\) has a"
                                           r" sample of 2\.94e\+03 m/s\^2"):
         read_text_record(big, units="g", dt=0.01)
+
+
+# ------------------------------------------------------------------------------ fuzz, kept
+
+
+@pytest.mark.parametrize("reader", ["at2", "cosmos", "esm", "text"])
+def test_older_readers_survive_mutations_within_the_limits(tmp_path, reader):
+    """Mutated files (tests.reader_fuzz: cuts, dropped lines, numbers replaced by NaN, 1e-320,
+    1e999, garbage, bit flips) give a project error or finite samples at 1e-4..1 s under 100 g."""
+    from shipblock.io.at2 import read_at2
+    from tests.reader_fuzz import assert_reader_survives
+
+    files = {
+        "at2": (read_at2, (DATA / "helena_synthetic_180.AT2").read_bytes(), {}),
+        "cosmos": (read_cosmos, _cosmos_block(H1_CM).encode(), {}),
+        "esm": (read_esm, _esm_text([1.0, -2.0, 3.0, 0.5]).encode(), {}),
+        "text": (read_text_record, (DATA / "two_column_gal.csv").read_bytes(), {}),
+    }
+    read_fn, raw, kwargs = files[reader]
+    assert assert_reader_survives(read_fn, raw, seed=23, count=60, **kwargs) > 0

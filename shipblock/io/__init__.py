@@ -127,10 +127,13 @@ def _check_trace(trace, name: str) -> None:
     check_sampling_interval(trace.stats.delta, name,
                             f"{what}: sampling interval{' (SAC DELTA)' if fmt == 'SAC' else ''}")
     check_start_time(trace.stats.starttime, name, what)
-    if trace.stats.get("units") == "m/s**2" and np.issubdtype(trace.data.dtype, np.floating):
-        if not np.all(np.isfinite(trace.data)):
-            raise RecordError(name, f"{what} has NaN/inf samples")
-        check_plausible_samples(trace.data, name, what)
+    if np.issubdtype(trace.data.dtype, np.floating):
+        bad = ~np.isfinite(trace.data)
+        if bad.any():
+            raise RecordError(name, f"{what} has {int(bad.sum())} NaN/inf samples (first at"
+                                    f" index {int(np.flatnonzero(bad)[0])})")
+        if trace.stats.get("units") == "m/s**2":
+            check_plausible_samples(trace.data, name, what)
 
 
 def read_record(path, format: str | None = None, units: str | None = None, **kwargs):

@@ -411,8 +411,11 @@ def _read_block(cursor: _Lines, name: str, headonly: bool, horizontals: list):
 
     m = cursor.expect(_INT_HEADER, "integer-header")
     count, n_lines, per_line, width = (int(g) for g in m.groups())
-    ints = [int(v) for v in _fixed_width(cursor.take(n_lines, "integer header"), count,
-                                         per_line, width, name, "integer header")]
+    ints = _fixed_width(cursor.take(n_lines, "integer header"), count, per_line, width, name,
+                        "integer header")
+    if not all(math.isfinite(v) for v in ints):
+        raise RecordError(name, f"line {block_line}: the integer header holds NaN/inf")
+    ints = [int(v) for v in ints]
     m = cursor.expect(_REAL_HEADER, "real-header")
     count, n_lines, per_line, width = (int(g) for g in m.groups())
     reals = _fixed_width(cursor.take(n_lines, "real header"), count, per_line, width, name,

@@ -37,6 +37,7 @@ References
 
 from __future__ import annotations
 
+import math
 import re
 import warnings
 
@@ -130,11 +131,14 @@ def _float(header, key, name, required=True):
             raise RecordError(name, f"header key {key} is missing or empty")
         return None
     try:
-        return parse_float(raw)
+        value = parse_float(raw)
     except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
         if required:
-            raise RecordError(name, f"header key {key}={raw!r} is not a number") from None
+            raise RecordError(name, f"header key {key}={raw!r} is not a finite number")
         return None
+    return value
 
 
 def _start_time(raw: str) -> UTCDateTime | None:
