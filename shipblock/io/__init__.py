@@ -26,8 +26,10 @@ K-NET and KiK-net files are read by obspy and renamed the SEED way by
 :func:`shipblock.io.knet.normalise_knet`.
 
 :func:`read_record` wraps :func:`obspy.read` so that every failure becomes a
-:class:`~shipblock.errors.RecordError` naming the file, and so that plain text files (which obspy
-cannot auto-detect, their units being unknown) are read with the caller's ``units``.
+:class:`~shipblock.errors.RecordError` naming the file, so that a damaged file (a warning of
+libmseed, a MiniSEED record cut short, an implausible interval, start time or sample) is refused
+rather than read, and so that plain text files (which obspy cannot auto-detect, their units being
+unknown) are read with the caller's ``units``.
 """
 
 from __future__ import annotations
@@ -161,7 +163,10 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
     Raises
     ------
     RecordError
-        If the file does not exist, its format is unknown, or it is corrupt or truncated.
+        If the file does not exist, its format is unknown, or it is corrupt or truncated: any
+        libmseed diagnostic (a Steim integrity check, a record cut short) or MiniSEED records
+        that do not account for every byte of the file; NaN/inf samples; a sampling interval
+        outside 1e-4..1 s; a start time outside 1900-2200; samples in m/s^2 above 100 g.
     """
     name = os.fspath(path)
     if not os.path.isfile(name):
