@@ -13,8 +13,10 @@ Grouping key of a trace: network, station, location, the first two letters of th
 and ``.V2``, GeoNet ``.V1A`` and ``.V2A``, ...), the file's extension, so that a station's
 uncorrected and corrected volumes are two records, not one with six components. Traces of one
 key whose time windows do not overlap are different records (two earthquakes at one station,
-or a recording split in two files); a channel that still appears twice (two copies of one
-record, in two folders or two files) splits the group by folder, then by file.
+or a recording split in two files); the traces of one file are never split by time (a damaged
+record time then fails that file's record, by name, instead of making a record of its own). A
+channel that still appears twice (two copies of one record, in two folders or two files) splits
+the group by folder, then by file.
 """
 
 from __future__ import annotations
@@ -125,15 +127,28 @@ def _group_key(trace) -> tuple:
 
 
 def _overlapping(stream: Stream) -> list[Stream]:
-    """Split traces into clusters whose time windows overlap."""
+    """Split traces into clusters whose time windows overlap.
+
+    The traces of one file stay together, whatever their times: a file holding a channel in
+    pieces far apart in time is one record with gaps (refused by read_motion, naming the file),
+    not several records; a damaged record time must not make a record of its own.
+    """
+    files: dict[str, Stream] = {}
+    for trace in stream:
+        files.setdefault(str(trace.stats.get("source_file", "")), Stream()).append(trace)
+    units = sorted(
+        ((min(tr.stats.starttime for tr in part), max(tr.stats.endtime for tr in part), part)
+         for part in files.values()),
+        key=lambda unit: unit[0],
+    )
     clusters: list[Stream] = []
     end = None
-    for trace in sorted(stream, key=lambda tr: tr.stats.starttime):
-        if end is None or trace.stats.starttime > end:
+    for start, stop, part in units:
+        if end is None or start > end:
             clusters.append(Stream())
-            end = trace.stats.endtime
-        clusters[-1].append(trace)
-        end = max(end, trace.stats.endtime)
+            end = stop
+        clusters[-1] += part
+        end = max(end, stop)
     return clusters
 
 

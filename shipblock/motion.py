@@ -36,7 +36,14 @@ from obspy import Stream, Trace, UTCDateTime
 
 from shipblock.errors import ParameterError, RecordError, UnitsError
 from shipblock.io import read_record
-from shipblock.io._common import canonical_unit, canonical_velocity_unit, si_factor
+from shipblock.io._common import (
+    MAX_DIGITIZATION_GAP_S,
+    canonical_unit,
+    canonical_velocity_unit,
+    check_count_value,
+    check_plausible_samples,
+    si_factor,
+)
 from shipblock.units import ACCELERATION_UNITS_TO_SI, STANDARD_GRAVITY, VELOCITY_UNITS_TO_SI
 
 __all__ = [
@@ -72,6 +79,17 @@ LANCZOS_HALF_WIDTH = 20
 
 #: Time offsets smaller than this fraction of a sample are treated as zero [-].
 SAMPLE_FRACTION_TOLERANCE = 1e-3
+
+#: Longest gap inside a channel that ``gaps="interpolate"`` fills by a straight line [s]: as for
+#: digitized records (:data:`shipblock.io._common.MAX_DIGITIZATION_GAP_S`), a longer hole would
+#: replace the 1-25 Hz motion the ship responds to by a line. Any gap is refused by default.
+MAX_INTERPOLATED_GAP_S = MAX_DIGITIZATION_GAP_S
+
+#: Largest share of a record's span (from the earliest start to the latest end of its components)
+#: that trimming the components to their common window may drop [-]. Real records' components
+#: differ by up to 3.1 % (CI.MPM, gmprocess corpus: ends at 66.05-68.19 s); a component with much
+#: less than the others is damaged (a truncated file, a lost record) and is refused.
+WINDOW_TOLERANCE_FRACTION = 0.05
 
 #: Formats whose ``stats.calib`` (set by obspy from the file header) is m/s^2 per count.
 CALIB_IN_SI_FORMATS = {
@@ -231,8 +249,79 @@ def _load_event(event):
     return summary
 
 
+def _seconds(duration_s: float) -> str:
+    """A duration in words a reader can judge: seconds, or days/years when it is that long."""
+    if abs(duration_s) >= 2 * 86400.0 * 365.25:
+        return f"{duration_s:.6g} s ({duration_s / (86400.0 * 365.25):.3g} years)"
+    if abs(duration_s) >= 2 * 86400.0:
+        return f"{duration_s:.6g} s ({duration_s / 86400.0:.3g} days)"
+    return f"{duration_s:.6g} s"
+
+
+def _segments(group: Stream, name: str, seed_id: str):
+    """Gaps and overlaps between the traces of one channel, found from their headers alone.
+
+    Returns
+    -------
+    list of (obspy.UTCDateTime, float)
+        ``(end of the data before the gap, gap length [s])``: time without samples, beyond half
+        a sample.
+
+    Raises
+    ------
+    RecordError
+        If two traces overlap with different samples (two versions of the same time: a damaged
+        time field, or two different recordings under one channel code).
+    """
+    delta = group[0].stats.delta
+    ordered = sorted(group, key=lambda tr: tr.stats.starttime)
+    found = []
+    covered = ordered[0]
+    for trace in ordered[1:]:
+        missing = trace.stats.starttime - covered.stats.endtime - delta  # [s]
+        if missing > 0.5 * delta:
+            found.append((covered.stats.endtime, missing))
+        elif missing < -0.5 * delta:
+            for earlier in ordered:
+                if earlier is trace:
+                    break
+                _check_overlap(earlier, trace, name, seed_id)
+        if trace.stats.endtime > covered.stats.endtime:
+            covered = trace
+    return found
+
+
+def _check_overlap(first: Trace, second: Trace, name: str, seed_id: str) -> None:
+    """Refuse two traces of one channel whose common time holds different samples."""
+    delta = first.stats.delta
+    start = max(first.stats.starttime, second.stats.starttime)
+    end = min(first.stats.endtime, second.stats.endtime)
+    if end < start:
+        return
+    offset_a = (start - first.stats.starttime) / delta
+    offset_b = (start - second.stats.starttime) / delta
+    count = int(round((end - start) / delta)) + 1
+    aligned = max(abs(offset_a - round(offset_a)), abs(offset_b - round(offset_b)))
+    a = np.asarray(first.data[int(round(offset_a)):int(round(offset_a)) + count])
+    b = np.asarray(second.data[int(round(offset_b)):int(round(offset_b)) + count])
+    if aligned <= SAMPLE_FRACTION_TOLERANCE and a.shape == b.shape and np.array_equal(a, b):
+        return  # the same samples twice (a repeated record): merged as one
+    raise RecordError(
+        name,
+        f"channel {seed_id} holds two different recordings of {_seconds(end - start)} from"
+        f" {start} (overlapping records with different samples: a damaged record time?)",
+    )
+
+
 def _merge_gaps(stream: Stream, gaps: str) -> Stream:
-    """Merge traces of the same channel; refuse or fill gaps."""
+    """Merge traces of the same channel; refuse or fill gaps.
+
+    Gaps and overlaps are found from the traces' headers before anything is merged, so that a
+    damaged record time (a MiniSEED record put years away) is refused at once, without
+    allocating the span it would make.
+    """
+    if gaps not in ("refuse", "interpolate"):
+        raise ParameterError(f"gaps must be 'refuse' or 'interpolate', not {gaps!r}")
     merged = Stream()
     for seed_id in dict.fromkeys(tr.id for tr in stream):
         group = Stream([tr for tr in stream if tr.id == seed_id])
@@ -248,27 +337,32 @@ def _merge_gaps(stream: Stream, gaps: str) -> Stream:
         rates = {tr.stats.sampling_rate for tr in group}
         if len(rates) > 1:
             raise RecordError(name, f"channel {seed_id} changes sampling rate ({sorted(rates)} Hz)")
-        gap_list = group.get_gaps()
-        try:
+        gap_list = _segments(group, name, seed_id)
+        if gap_list:
+            first_end, first_gap = gap_list[0]
+            longest = max(length for _, length in gap_list)
+            where = (f"{len(gap_list)} gap(s), the first of {_seconds(first_gap)} after {first_end}"
+                     + (f", the longest {_seconds(longest)}" if len(gap_list) > 1 else ""))
             if gaps == "refuse":
-                joined = group.copy().merge(method=1, fill_value=None)
-            elif gaps == "interpolate":
-                joined = group.copy().merge(method=1, fill_value="interpolate")
-            else:
-                raise ParameterError(f"gaps must be 'refuse' or 'interpolate', not {gaps!r}")
-        except ValueError:
-            raise
+                raise RecordError(
+                    name, f"channel {seed_id} has {where}; pass gaps='interpolate' to fill gaps"
+                    f" of up to {MAX_INTERPOLATED_GAP_S:g} s",
+                )
+            if longest > MAX_INTERPOLATED_GAP_S:
+                raise RecordError(
+                    name, f"channel {seed_id} has {where}: longer than the"
+                    f" {MAX_INTERPOLATED_GAP_S:g} s gaps='interpolate' fills (a damaged record"
+                    " time, or a recording with a hole in it)",
+                )
+        try:
+            joined = group.copy().merge(method=1, fill_value="interpolate" if gap_list else None)
         except Exception as exc:  # noqa: BLE001
             raise RecordError(name, f"channel {seed_id} cannot be merged: {exc}") from exc
         trace = joined[0]
-        if np.ma.isMaskedArray(trace.data) and np.ma.count_masked(trace.data):
-            first = gap_list[0] if gap_list else None
-            where = f" (first from {first[4]} to {first[5]})" if first else ""
-            raise RecordError(
-                name,
-                f"channel {seed_id} has {len(gap_list)} gap(s){where}; pass gaps='interpolate'"
-                " to fill them",
-            )
+        if np.ma.isMaskedArray(trace.data):
+            if np.ma.count_masked(trace.data):
+                raise RecordError(name, f"channel {seed_id} has masked samples after merging")
+            trace.data = np.ma.getdata(trace.data)
         if gap_list:
             trace.stats.shipblock_gaps_filled = len(gap_list)
         merged += joined
@@ -333,12 +427,15 @@ def _by_sensitivity(trace, response, source_label, differentiate, name, note="")
             name, f"{source_label} has no usable sensitivity for channel {trace.id}"
             f" (value {value!r}; a finite, non-zero number of counts per input unit is needed)"
         )
+    input_units = sensitivity.input_units or ""
+    quantity, factor = _input_unit(input_units)
+    if quantity is not None:
+        check_count_value(factor / value, name, f"{source_label}: channel {trace.id}'s sensitivity"
+                                                f" {value:.6g} counts/({input_units})")
     if value < 0:
         # A negative sensitivity states a channel wired with reversed polarity (BK.VALB HN3 in
         # real BK metadata): dividing by it restores the ground's sign.
         note += " (negative: the channel's polarity is reversed and is restored)"
-    input_units = sensitivity.input_units or ""
-    quantity, factor = _input_unit(input_units)
     if quantity is None:
         raise UnitsError(
             name, f"{source_label}: channel {trace.id} senses {input_units or 'unknown units'},"
@@ -421,7 +518,9 @@ def _to_si(trace: Trace, inventory, inventory_name, units, response, differentia
     current = stats.get("units")
     if current == _SI_UNITS:
         original = stats.get("original_units", _SI_UNITS)
-        if units is not None and si_factor(units, name) != si_factor(original, name):
+        key = canonical_unit(str(original))
+        if units is not None and (key is None or si_factor(units, name)
+                                  != ACCELERATION_UNITS_TO_SI[key]):
             raise UnitsError(name, f"units={units!r} contradicts the file's own unit {original!r}")
         return f"{original} -> m/s**2 from the file header ({fmt or 'stream'})"
     if current == "m/s" and units is None:
@@ -445,6 +544,8 @@ def _to_si(trace: Trace, inventory, inventory_name, units, response, differentia
             raise UnitsError(
                 name, f"{fmt} records carry their own calibration; do not give units="
             )
+        check_count_value(stats.calib, name, f"the {CALIB_IN_SI_FORMATS[fmt]} (calibration"
+                                             f" {stats.calib!r} m/s^2 per count)")
         trace.data = np.asarray(trace.data, dtype=np.float64) * stats.calib
         how = f"counts -> m/s**2 by stats.calib={stats.calib:.6g} ({CALIB_IN_SI_FORMATS[fmt]})"
         stats.calib = 1.0
@@ -467,6 +568,12 @@ def _to_si(trace: Trace, inventory, inventory_name, units, response, differentia
         data = np.asarray(trace.data, dtype=np.float64)
         prefix = ""
         if stats.calib != 1.0:
+            velocity = canonical_velocity_unit(units)
+            unit_si = (VELOCITY_UNITS_TO_SI[velocity] if velocity is not None
+                       else si_factor(units, name))
+            check_count_value(stats.calib * unit_si, name,
+                              f"the {'SAC SCALE' if fmt == 'SAC' else 'calibration'}"
+                              f" {stats.calib!r} ({units} per count)")
             data = data * stats.calib
             prefix = f"calib {stats.calib:g} from the {fmt or 'stream'} header, then "
             stats.calib = 1.0
@@ -615,6 +722,16 @@ def _assign_components(
             if component in assigned:
                 raise RecordError(label, f"two channels are mapped to {component}")
             assigned[component] = trace
+        absent = sorted({c for c in channel_map.values() if c in COMPONENTS} - set(assigned),
+                        key=COMPONENTS.index)
+        if absent:
+            raise RecordError(
+                label, "the component mapping names "
+                + ", ".join(f"{c} ({', '.join(k for k, v in channel_map.items() if v == c)})"
+                            for c in absent)
+                + " but the files hold no such channel (a missing or damaged file?); they hold "
+                + ", ".join(tr.id for tr in stream),
+            )
     else:
         stations = {(tr.stats.network.upper(), tr.stats.station.upper(), tr.stats.location.upper())
                         for tr in stream}
@@ -705,13 +822,35 @@ def _order_horizontals(horizontals, info):
 # --------------------------------------------------------------------------------------------
 
 
+def _describe(traces: list[Trace], origin) -> str:
+    """Each component's rate, window (from ``origin``) and sample count, for error messages."""
+    return "; ".join(
+        f"{tr.stats[COMPONENT_KEY]} ({tr.id}) {tr.stats.sampling_rate:g} Hz,"
+        f" {tr.stats.starttime - origin:.6g}-{tr.stats.endtime - origin:.6g} s,"
+        f" {tr.stats.npts} samples"
+        for tr in traces
+    )
+
+
 def _align(traces: list[Trace], align: str, notes: list[str]) -> None:
-    """Bring traces to one sampling rate and one time window, in place."""
+    """Bring traces to one sampling rate and one time window, in place.
+
+    Components must share one sampling rate (``align="resample"`` brings them to the lowest)
+    and cover one window: trimming them to their common window may drop at most
+    :data:`WINDOW_TOLERANCE_FRACTION` of the record's span, or one sample; beyond that, or with
+    ``align="strict"`` any difference, the record is refused with the numbers.
+    """
     label = _source(traces[0])
+    origin = min(tr.stats.starttime for tr in traces)
     rates = sorted({tr.stats.sampling_rate for tr in traces})
-    if len(rates) > 1:
-        if align == "strict":
-            raise RecordError(label, f"components have different sampling rates {rates} Hz")
+    if any(not math.isclose(rate, rates[0], rel_tol=1e-9) for rate in rates):
+        if align != "resample":
+            raise RecordError(
+                label,
+                f"components have different sampling rates ({_describe(traces, origin)});"
+                " pass align='resample' to resample them to the lowest rate"
+                f" ({rates[0]:g} Hz) after an anti-alias low-pass",
+            )
         target = rates[0]
         for tr in traces:
             if tr.stats.sampling_rate != target:
@@ -728,6 +867,9 @@ def _align(traces: list[Trace], align: str, notes: list[str]) -> None:
                     " after a"
                     f" zero-phase Butterworth low-pass at {ANTI_ALIAS_FRACTION * target / 2:g} Hz"
                 )
+    else:
+        for tr in traces[1:]:
+            tr.stats.sampling_rate = traces[0].stats.sampling_rate  # equal within 1e-9
     delta = traces[0].stats.delta
     start = max(tr.stats.starttime for tr in traces)
     end = min(tr.stats.endtime for tr in traces)
@@ -745,7 +887,20 @@ def _align(traces: list[Trace], align: str, notes: list[str]) -> None:
                         for tr in traces),
         )
     if end - start < delta:
-        raise RecordError(label, "components do not overlap in time")
+        raise RecordError(label, "components do not overlap in time: "
+                          + _describe(traces, origin))
+    span = max(tr.stats.endtime for tr in traces) - origin + delta
+    dropped = span - (end - start + delta)
+    allowed = max(delta, WINDOW_TOLERANCE_FRACTION * span)
+    if dropped > allowed * (1.0 + 1e-9):
+        raise RecordError(
+            label,
+            f"components do not cover one time window: their common window"
+            f" {start - origin:.6g}-{end - origin:.6g} s would drop {dropped:.6g} s"
+            f" ({100.0 * dropped / span:.3g} %) of the record's {span:.6g} s, more than"
+            f" {100.0 * WINDOW_TOLERANCE_FRACTION:g} % ({_describe(traces, origin)}): a"
+            " truncated or damaged component?",
+        )
     for tr in traces:
         offset = (start - tr.stats.starttime) / delta
         if abs(offset - round(offset)) > SAMPLE_FRACTION_TOLERANCE:
@@ -764,7 +919,8 @@ def _align(traces: list[Trace], align: str, notes: list[str]) -> None:
     for tr in traces:
         if tr.stats.npts > npts:
             tr.data = tr.data[:npts]
-    notes.append(f"components trimmed to the common window {start} ({npts} samples)")
+    notes.append(f"components trimmed to the common window {start} ({npts} samples;"
+                 f" {dropped:.6g} s of the {span:.6g} s span dropped)")
 
 
 # --------------------------------------------------------------------------------------------
@@ -1134,10 +1290,14 @@ def read_motion(
     event : str, os.PathLike, obspy.core.event.Event, obspy.Catalog or dict, optional
         The earthquake (QuakeML file or object), summarised into ``metadata["event"]``.
     gaps : {"refuse", "interpolate"}, optional
-        What to do with gaps inside a channel.
-    align : {"trim", "strict"}, optional
-        ``"trim"`` resamples components to the lowest sampling rate (anti-alias low-pass first) and
-        trims them to their common time window; ``"strict"`` refuses any mismatch.
+        What to do with gaps inside a channel: refuse them (default), or fill gaps of up to
+        :data:`MAX_INTERPOLATED_GAP_S` by linear interpolation. Overlapping traces of a channel
+        must hold the same samples.
+    align : {"trim", "resample", "strict"}, optional
+        ``"trim"`` (default) trims components of one sampling rate to their common time window,
+        dropping at most :data:`WINDOW_TOLERANCE_FRACTION` of the record's span (or one sample);
+        ``"resample"`` also brings components of different rates to the lowest (anti-alias
+        low-pass first); ``"strict"`` refuses any mismatch.
     format : str, optional
         obspy format name for all files (auto-detected when omitted).
     differentiate : bool, optional
@@ -1159,14 +1319,19 @@ def read_motion(
     ------
     RecordError
         For unreadable, corrupt or truncated files, unknown formats, NaN/inf samples, empty traces,
-        gaps, mismatched components, missing horizontals, or an inventory that does not match.
+        gaps, overlapping records with different samples, components of different rates or
+        windows (beyond the tolerances above), accelerations above 100 g, a sensitivity or
+        calibration that is not a number an instrument has, missing horizontals, or an inventory
+        that does not match.
     UnitsError
         If the units of a trace are unknown or contradictory.
     """
     if azimuth is not None and horizontal is not None:
         raise ParameterError("give azimuth= or horizontal=, not both")
-    if align not in ("trim", "strict"):
-        raise ParameterError(f"align must be 'trim' or 'strict', not {align!r}")
+    if align not in ("trim", "resample", "strict"):
+        raise ParameterError(f"align must be 'trim', 'resample' or 'strict', not {align!r}")
+    if gaps not in ("refuse", "interpolate"):
+        raise ParameterError(f"gaps must be 'refuse' or 'interpolate', not {gaps!r}")
     if _names_many(paths_or_stream):
         return _one_of_folder(paths_or_stream, inventory, units, response, differentiate, align,
                               gaps, event, azimuth, horizontal, sensor)
@@ -1192,6 +1357,8 @@ def read_motion(
                 trace, inv, inventory_name, units, response, differentiate
             )
         _check_finite(trace)
+        check_plausible_samples(np.asarray(trace.data), _source(trace),
+                                f"channel {trace.id} ({units_done[component]})")
     sites = {trace.stats.get("sensor_site") for trace in assigned.values()} & set(SITE_NOTES)
     for site in sorted(sites):
         notes.append(SITE_NOTES[site])

@@ -213,14 +213,17 @@ def test_from_arrays_and_with_stream():
         GroundMotion.from_arrays([1.0], dt=0.01, units="furlongs")
 
 
-def test_different_sampling_rates_resampled_with_anti_alias():
+def test_different_sampling_rates_refused_unless_resample_asked():
     t200 = np.arange(2000) / 200.0
     t100 = np.arange(1000) / 100.0
     signal = lambda t: np.sin(2 * np.pi * 1.0 * t)  # noqa: E731 - 1 Hz, well below Nyquist
     alias = np.sin(2 * np.pi * 80.0 * t200)  # 80 Hz: above the 50 Hz Nyquist of 100 Hz
     st_ = Stream([_trace(signal(t200) + alias, "HNN", rate=200.0),
                   _trace(signal(t100), "HNE", rate=100.0)])
-    gm = read_motion(st_, units="m/s^2")
+    with pytest.raises(RecordError, match=r"different sampling rates \(H1 .*200 Hz.*H2 .*100 Hz"
+                                          r".*align='resample'"):
+        read_motion(st_, units="m/s^2")
+    gm = read_motion(st_, units="m/s^2", align="resample")
     assert gm.dt == pytest.approx(0.01)
     h1 = gm.components["H1"]
     inner = slice(100, -100)
@@ -230,25 +233,55 @@ def test_different_sampling_rates_resampled_with_anti_alias():
         read_motion(st_, units="m/s^2", align="strict")
 
 
-def test_lengths_trimmed_or_refused():
-    st_ = Stream([_trace(np.ones(100), "HNN"), _trace(np.ones(80), "HNE", start=0.1)])
+def test_lengths_trimmed_within_tolerance_or_refused():
+    """Trimming may drop up to 5 % of the record's span (WINDOW_TOLERANCE_FRACTION)."""
+    # 1000 samples at 100 Hz (10 s); H2 starts 0.2 s late and ends 0.2 s early: 4 % dropped.
+    st_ = Stream([_trace(np.ones(1000), "HNN"), _trace(np.ones(960), "HNE", start=0.2)])
     gm = read_motion(st_, units="gal")
-    assert gm.npts == 80 and gm.stream[0].stats.starttime == UTCDateTime(0.1)
+    assert gm.npts == 960 and gm.stream[0].stats.starttime == UTCDateTime(0.2)
+    assert any("0.4 s of the 10 s span dropped" in p for p in gm.metadata["processing"])
     with pytest.raises(RecordError, match="differ in start time or length"):
         read_motion(st_, units="gal", align="strict")
+    # 0.6 s (6 %) would be dropped: refused with each component's window.
+    beyond = Stream([_trace(np.ones(1000), "HNN"), _trace(np.ones(940), "HNE", start=0.3)])
+    with pytest.raises(RecordError, match=r"drop 0\.6 s \(6 %\).*H1 \(XX\.SYN\.\.HNN\) 100 Hz,"
+                                          r" 0-9\.99 s, 1000 samples; H2 .* 0\.3-9\.69 s, 940"):
+        read_motion(beyond, units="gal")
     apart = Stream([_trace(np.ones(10), "HNN"), _trace(np.ones(10), "HNE", start=100.0)])
     with pytest.raises(RecordError, match="do not overlap"):
         read_motion(apart, units="gal")
 
 
-def test_gaps_refused_or_interpolated():
+def test_a_two_sample_component_does_not_trim_the_others():
+    """Issue 23: one component of 2 samples trimmed all three to 2 samples; now refused."""
+    st_ = Stream([_trace(np.ones(3000), "HNN"), _trace(np.ones(3000), "HNE"),
+                  _trace(np.ones(2), "HNZ")])
+    with pytest.raises(RecordError, match=r"V \(XX\.SYN\.\.HNZ\) 100 Hz, 0-0\.01 s, 2 samples"):
+        read_motion(st_, units="gal")
+
+
+def test_gaps_refused_or_interpolated_up_to_a_quarter_second():
     a = _trace(np.arange(100.0), "HNN")
-    b = _trace(np.arange(150.0, 250.0), "HNN", start=1.5)
-    with pytest.raises(RecordError, match="gap"):
-        read_motion(Stream([a, b]), units="g")
-    gm = read_motion(Stream([a, b]), units="g", gaps="interpolate")
-    assert gm.npts == 250
-    np.testing.assert_allclose(gm.horizontal[120], 120.0 * G)
+    b = _trace(np.arange(120.0, 220.0), "HNN", start=1.2)  # samples 100-119 (0.2 s) missing
+    with pytest.raises(RecordError, match=r"1 gap\(s\), the first of 0\.2 s"):
+        read_motion(Stream([a, b]), units="gal")
+    gm = read_motion(Stream([a, b]), units="gal", gaps="interpolate")
+    assert gm.npts == 220
+    np.testing.assert_allclose(gm.horizontal[110], 110.0 * 0.01)
+    c = _trace(np.arange(150.0, 250.0), "HNN", start=1.5)  # 0.5 s missing: too long to fill
+    with pytest.raises(RecordError, match="longer than the 0.25 s gaps='interpolate' fills"):
+        read_motion(Stream([a, c]), units="gal", gaps="interpolate")
+
+
+def test_overlapping_records_must_agree():
+    """Repeated samples merge into one; different samples for one time are refused."""
+    a = _trace(np.arange(100.0), "HNN")
+    repeat = _trace(np.arange(50.0, 150.0), "HNN", start=0.5)  # samples 50-99 again, same values
+    gm = read_motion(Stream([a, repeat]), units="gal")
+    np.testing.assert_array_equal(gm.horizontal, np.arange(150.0) * 0.01)
+    other = _trace(np.arange(50.0, 150.0) + 1.0, "HNN", start=0.5)
+    with pytest.raises(RecordError, match="two different recordings of 0.49 s"):
+        read_motion(Stream([a, other]), units="gal")
 
 
 def test_bad_traces(tmp_path):

@@ -26,8 +26,10 @@ K-NET and KiK-net files are read by obspy and renamed the SEED way by
 :func:`shipblock.io.knet.normalise_knet`.
 
 :func:`read_record` wraps :func:`obspy.read` so that every failure becomes a
-:class:`~shipblock.errors.RecordError` naming the file, and so that plain text files (which obspy
-cannot auto-detect, their units being unknown) are read with the caller's ``units``.
+:class:`~shipblock.errors.RecordError` naming the file, so that a damaged file (a warning of
+libmseed, a MiniSEED record cut short, an implausible interval, start time or sample) is refused
+rather than read, and so that plain text files (which obspy cannot auto-detect, their units being
+unknown) are read with the caller's ``units``.
 """
 
 from __future__ import annotations
@@ -35,14 +37,26 @@ from __future__ import annotations
 import os
 import warnings
 
+import numpy as np
 import obspy
 
 from shipblock.errors import RecordError, ShipblockError
 from shipblock.io import at2, bhrc, cosmos, cwb, dmg, esm, geonet, nsmn, renadic, smc, text, unam, usc
-from shipblock.io._common import peek_text
+from shipblock.io._common import (
+    check_plausible_samples,
+    check_sampling_interval,
+    check_start_time,
+    peek_text,
+)
 from shipblock.io.knet import normalise_knet
 
 __all__ = ["FORMATS", "read_record"]
+
+#: Words of a reader's warning that mean the file is damaged: libmseed's reports (truncated
+#: records, Steim integrity checks) and truncation notices. A damaged file is refused rather than
+#: read with samples changed or missing.
+DAMAGE_WORDS = ("end of file", "truncated", "integrity check", "last record only has",
+                "not a seed record", "not enough to constitute")
 
 #: The formats shipblock adds to obspy: name -> (detector, reader).
 FORMATS = {
@@ -79,6 +93,51 @@ def _looks_like_plain_text(path) -> bool:
     return numeric >= max(1, len(lines) // 2)
 
 
+def _is_damage(warning) -> bool:
+    """Whether a warning caught while reading says the file is damaged."""
+    if type(warning.message).__name__ == "InternalMSEEDWarning":
+        return True  # every libmseed diagnostic is about a record it could not decode as stored
+    message = str(warning.message).lower()
+    return any(word in message for word in DAMAGE_WORDS)
+
+
+def _check_mseed_size(stream, name: str) -> None:
+    """Refuse a MiniSEED file whose bytes are not all in the records obspy read.
+
+    libmseed skips a record cut short at the end of the file without a word when too little of
+    it is left to parse; the records read then cover fewer bytes than the file holds.
+    """
+    mseed = [tr.stats.mseed for tr in stream if tr.stats.get("_format") == "MSEED"
+             and "mseed" in tr.stats]
+    if not mseed or "filesize" not in mseed[0]:
+        return
+    used = sum(int(m.number_of_records) * int(m.record_length) for m in mseed)
+    size = int(mseed[0].filesize)
+    if used != size:
+        what = ("left over: a record cut short (truncated file?)" if size > used
+                else "missing")
+        raise RecordError(
+            name, f"is damaged: its records hold {used} bytes but the file has {size}"
+            f" ({abs(size - used)} bytes {what})"
+        )
+
+
+def _check_trace(trace, name: str) -> None:
+    """Refuse a trace with an implausible sampling interval, start time or acceleration."""
+    what = f"channel {trace.id}"
+    fmt = trace.stats.get("_format", "")
+    check_sampling_interval(trace.stats.delta, name,
+                            f"{what}: sampling interval{' (SAC DELTA)' if fmt == 'SAC' else ''}")
+    check_start_time(trace.stats.starttime, name, what)
+    if np.issubdtype(trace.data.dtype, np.floating):
+        bad = ~np.isfinite(trace.data)
+        if bad.any():
+            raise RecordError(name, f"{what} has {int(bad.sum())} NaN/inf samples (first at"
+                                    f" index {int(np.flatnonzero(bad)[0])})")
+        if trace.stats.get("units") == "m/s**2":
+            check_plausible_samples(trace.data, name, what)
+
+
 def read_record(path, format: str | None = None, units: str | None = None, **kwargs):
     """Read one record file into an obspy Stream.
 
@@ -104,7 +163,10 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
     Raises
     ------
     RecordError
-        If the file does not exist, its format is unknown, or it is corrupt or truncated.
+        If the file does not exist, its format is unknown, or it is corrupt or truncated: any
+        libmseed diagnostic (a Steim integrity check, a record cut short) or MiniSEED records
+        that do not account for every byte of the file; NaN/inf samples; a sampling interval
+        outside 1e-4..1 s; a start time outside 1900-2200; samples in m/s^2 above 100 g.
     """
     name = os.fspath(path)
     if not os.path.isfile(name):
@@ -132,14 +194,17 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
             raise RecordError(name, f"cannot be read (corrupt or truncated?): {exc}") from exc
     for warning in caught:
         message = str(warning.message)
-        if "end of file" in message.lower() or "truncated" in message.lower():
-            raise RecordError(name, f"is truncated or corrupt: {message}")
+        if _is_damage(warning):
+            raise RecordError(name, f"is damaged (truncated or corrupt): {message.strip()}")
         warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
     if len(stream) == 0:
         raise RecordError(name, "holds no traces")
     empty = [tr.id for tr in stream if tr.stats.npts == 0 or len(tr.data) == 0]
     if empty:
         raise RecordError(name, f"channel {empty[0]} has no samples (corrupt or truncated file?)")
+    _check_mseed_size(stream, name)
+    for trace in stream:
+        _check_trace(trace, name)
     normalise_knet(stream)
     for trace in stream:
         trace.stats.source_file = name

@@ -33,6 +33,21 @@ MAX_ACCELERATION_SI = 980.665
 MIN_SAMPLING_INTERVAL_S = 1e-4
 MAX_SAMPLING_INTERVAL_S = 1.0
 
+#: Range of times a record may start in (UTC). The oldest strong-motion records are of 1933 (Long
+#: Beach); files that state no start time are put at the epoch, 1970. A start outside comes from a
+#: damaged time field (a MiniSEED year, a SAC ``B`` of 1e30), not from an earthquake.
+EARLIEST_START = UTCDateTime(1900, 1, 1)
+LATEST_START = UTCDateTime(2200, 1, 1)
+
+#: Range of the acceleration (or velocity) that one count of raw data stands for [m/s^2 or m/s per
+#: count], from a StationXML sensitivity (its inverse), a SAC ``SCALE`` or a K-NET/EVT
+#: calibration. Real instruments lie between 4e-10 (a broadband seismometer, 2.5e9 counts/(m/s))
+#: and 7e-6 (a strong-motion accelerometer, 1.3e5 counts/(m/s^2)); data already in physical units
+#: have 1 (SI) or 9.8 (g). The range leaves two orders of margin on each side; beyond it the
+#: factor is a damaged number (a sensitivity of 1e300 or 1e-300), not an instrument.
+MIN_COUNT_VALUE_SI = 1e-12
+MAX_COUNT_VALUE_SI = 1e3
+
 #: Sampling rate onto which unevenly digitized (time, value) records are interpolated
 #: [samples/s].
 DEFAULT_RESAMPLE_RATE_HZ = 200.0
@@ -402,6 +417,64 @@ def check_sampling_interval(delta: float, name: str, what: str = "sampling inter
         raise RecordError(name, f"{what} {delta:g} s is outside"
                                 f" [{MIN_SAMPLING_INTERVAL_S:g}, {MAX_SAMPLING_INTERVAL_S:g}] s")
     return delta
+
+
+def check_start_time(starttime, name: str, what: str = "the record") -> None:
+    """Refuse a start time outside [:data:`EARLIEST_START`, :data:`LATEST_START`).
+
+    Parameters
+    ----------
+    starttime : obspy.UTCDateTime
+        Time of the first sample.
+    name : str
+        File name, for the error message.
+    what : str, optional
+        Which record or channel (for the error message).
+
+    Raises
+    ------
+    RecordError
+        If the time lies outside the range (a damaged time field).
+    """
+    if not EARLIEST_START <= starttime < LATEST_START:
+        # str() of such a time may overflow Python's datetime: say it in seconds.
+        raise RecordError(
+            name, f"{what} starts {float(starttime.ns) / 1e9:.6g} s from 1970-01-01, outside"
+            f" {EARLIEST_START.year}-{LATEST_START.year} (a damaged time field)"
+        )
+
+
+def check_count_value(value_si: float, name: str, what: str) -> float:
+    """Check what one count of raw data stands for, in SI units per count.
+
+    Parameters
+    ----------
+    value_si : float
+        Acceleration [m/s^2] (or velocity [m/s]) of one count; negative for a channel of reversed
+        polarity.
+    name : str
+        File name, for the error message.
+    what : str
+        Where the value comes from, e.g. ``"StationXML x.xml: sensitivity 4.2e5 counts/(M/S**2)"``.
+
+    Returns
+    -------
+    float
+        The value.
+
+    Raises
+    ------
+    RecordError
+        If the value is not finite, is zero, or its magnitude lies outside
+        [:data:`MIN_COUNT_VALUE_SI`, :data:`MAX_COUNT_VALUE_SI`].
+    """
+    if not (math.isfinite(value_si) and MIN_COUNT_VALUE_SI <= abs(value_si) <= MAX_COUNT_VALUE_SI):
+        raise RecordError(
+            name, f"{what} makes one count {value_si:.3g} in SI units, outside"
+            f" [{MIN_COUNT_VALUE_SI:g}, {MAX_COUNT_VALUE_SI:g}] (a damaged number, not an"
+            " instrument)"
+        )
+    return float(value_si)
 
 
 def check_plausible_samples(data_si: np.ndarray, name: str, what: str) -> float:

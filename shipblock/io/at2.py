@@ -9,9 +9,14 @@ header lines, then the samples read horizontally line by line (usually 5 per lin
 3. quantity and units, e.g. ``ACCELERATION TIME SERIES IN UNITS OF G``;
 4. ``NPTS=  4000, DT=   .0100 SEC`` (NGA) or ``4000   0.0100   NPTS, DT`` (older PEER files).
 
-The samples are in g (the format's unit; the header says so). They are converted to m/s^2 with
-:data:`shipblock.units.STANDARD_GRAVITY`; ``stats.units`` is ``"m/s**2"`` and
-``stats.original_units`` is ``"g"``. The component token of line 2 gives the orientation: a number
+The samples are in g (the format's unit; the header says so) unless line 3 names another unit
+after ``UNITS OF``: ``MG`` (milli-g), ``G/100`` and ``%G`` (hundredths of g), ``CM/S2``/``GAL``,
+``MM/S2``, ``M/S2``, ``KM/S2``, ``IN/S2``, ``FT/S^2`` (any spelling of s^2: ``S2``, ``S**2``,
+``SEC/SEC``). They are converted to m/s^2 (g = :data:`shipblock.units.STANDARD_GRAVITY`);
+``stats.units`` is ``"m/s**2"`` and ``stats.original_units`` the unit. A word that is not an
+acceleration unit is refused: a velocity (``CM/S``) or length (``CM``: displacement) as such, any
+other word as unknown; velocity and displacement files (PEER ``.VT2``, ``.DT2``) are refused. DT
+must lie within 1e-4..1 s and the samples under 100 g. The component token of line 2 gives the orientation: a number
 is the azimuth [deg clockwise from north]; ``UP``/``V``/``VER``/``Z`` is vertical positive up and
 ``DWN``/``DOWN`` vertical positive down. The file holds no start time, so traces start at the
 epoch (1970-01-01T00:00:00Z).
@@ -33,15 +38,17 @@ from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
     canonical_unit,
-    check_delta,
+    canonical_velocity_unit,
+    check_plausible_samples,
     check_samples,
+    check_sampling_interval,
     make_trace,
     parse_float,
     peek_text,
     read_text,
-    si_factor,
     source_name,
 )
+from shipblock.units import ACCELERATION_UNITS_TO_SI, INCH, STANDARD_GRAVITY
 
 __all__ = ["FORMAT", "is_at2", "read_at2"]
 
@@ -60,7 +67,28 @@ _NPTS_DT_NGA = re.compile(
 _NPTS_DT_OLD = re.compile(
     r"^\s*(\d+)\s+(" + FLOAT_RE.pattern + r")\s+NPTS\s*,\s*DT", re.IGNORECASE
 )
-_UNITS_RE = re.compile(r"UNITS\s+OF\s+([A-Z/*^0-9']+)|\(([A-Z/*^0-9' ]+)\)", re.IGNORECASE)
+_UNITS_RE = re.compile(r"UNITS\s+OF\s+([A-Z/*^0-9'%]+)", re.IGNORECASE)
+_PAREN_RE = re.compile(r"\(([A-Z/*^0-9'% ]+)\)", re.IGNORECASE)
+
+#: One foot [m] (international foot, 1959).
+FOOT = 0.3048
+
+#: Acceleration units the AT2 reader knows beyond :func:`shipblock.io._common.canonical_unit`
+#: (normalised spelling, see :func:`_normalise`) -> factor to m/s^2. ``km/s^2`` is a real unit
+#: (1000 m/s^2) and is converted; the 100 g plausibility check catches a file whose numbers are
+#: not what the header says.
+_EXTRA_ACCELERATION = {
+    "ft/s^2": FOOT,
+    "in/s^2": INCH,
+    "km/s^2": 1000.0,
+    "%g": 0.01 * STANDARD_GRAVITY,
+    "g%": 0.01 * STANDARD_GRAVITY,
+}
+
+#: Velocity and displacement units (normalised): an AT2 header naming one does not hold an
+#: acceleration.
+_VELOCITY = {"m/s", "cm/s", "mm/s", "km/s", "in/s", "ft/s", "nm/s"}
+_DISPLACEMENT = {"m", "cm", "mm", "km", "in", "ft", "nm"}
 _VERTICAL_UP = {"UP", "V", "VER", "VERT", "Z", "HNZ", "HLZ", "HHZ", "HGZ"}
 _VERTICAL_DOWN = {"DWN", "DOWN", "DN"}
 
@@ -124,19 +152,64 @@ def _orientation(component: str) -> dict:
     return {}
 
 
-def _units(line: str, name: str) -> tuple[str, bool]:
-    """Return the unit of the samples and whether the header stated it."""
+def _normalise(word: str) -> str:
+    """Lower-case a unit word and spell powers and seconds one way (``CM/SEC/SEC`` -> ``cm/s^2``)."""
+    key = word.strip().lower().replace(" ", "").replace("**", "^").replace("sec", "s")
+    key = re.sub(r"/s/s$", "/s^2", key)
+    return re.sub(r"/s2$", "/s^2", key)
+
+
+def _unit_factor(word: str) -> tuple[str, float] | None:
+    """``(unit, factor to m/s^2)`` of an acceleration unit word, or ``None`` if it is not one."""
+    key = canonical_unit(word)
+    if key is not None:
+        return key, ACCELERATION_UNITS_TO_SI[key]
+    norm = _normalise(word)
+    if norm in _EXTRA_ACCELERATION:
+        return norm, _EXTRA_ACCELERATION[norm]
+    fraction = re.fullmatch(r"g/(\d+)", norm)
+    if fraction and int(fraction.group(1)) > 0:
+        return norm, STANDARD_GRAVITY / int(fraction.group(1))
+    key = canonical_unit(norm)
+    if key is not None:
+        return key, ACCELERATION_UNITS_TO_SI[key]
+    return None
+
+
+def _units(line: str, name: str) -> tuple[str, float, bool]:
+    """Return the unit of the samples, its factor to m/s^2, and whether the header stated it.
+
+    The unit is the word after ``UNITS OF`` (or a unit word in parentheses). A header that names
+    no unit means g (the format's unit); a word that is not an acceleration unit is refused.
+    """
     upper = line.upper()
     if "VELOCITY" in upper or "DISPLACEMENT" in upper:
-        raise UnitsError(name, f"holds {line.strip()!r}, not an acceleration time series")
-    for match in _UNITS_RE.finditer(line):
-        token = (match.group(1) or match.group(2) or "").strip()
-        for candidate in (token, token.rstrip("S").rstrip("'")):
-            key = canonical_unit(candidate)
-            if key is not None:
-                return key, True
-    # The AT2 format is defined in g; a header that does not repeat it still means g.
-    return "g", False
+        raise UnitsError(name, f"holds {line.strip()!r}, not an acceleration time series (read the"
+                               " record's .AT2 acceleration file)")
+    stated = _UNITS_RE.search(line)
+    if stated is not None:
+        word = stated.group(1).rstrip("'")
+    else:
+        words = [m.group(1).strip() for m in _PAREN_RE.finditer(line)]
+        word = next((w for w in words if _unit_factor(w) is not None), None)
+        if word is None:
+            # The AT2 format is defined in g; a header that does not repeat it still means g.
+            return "g", STANDARD_GRAVITY, False
+    found = _unit_factor(word) or _unit_factor(word.rstrip("Ss"))  # G'S, GS
+    if found is not None:
+        return found[0], found[1], True
+    norm = _normalise(word)
+    if norm in _VELOCITY or canonical_velocity_unit(word) is not None:
+        raise UnitsError(name, f"header line {line.strip()!r} gives the unit {word!r}, a velocity:"
+                               " not an acceleration")
+    if norm in _DISPLACEMENT:
+        raise UnitsError(name, f"header line {line.strip()!r} gives the unit {word!r}, a length"
+                               " (displacement): not an acceleration")
+    raise UnitsError(
+        name, f"unknown acceleration unit {word!r} in header line {line.strip()!r}; known: g, mg,"
+        " g/N, %g, cm/s^2 (gal), mm/s^2, m/s^2, km/s^2, in/s^2, ft/s^2 (any spelling of s^2:"
+        " s2, s**2, sec/sec)",
+    )
 
 
 def read_at2(filename, headonly: bool = False, **kwargs) -> Stream:
@@ -175,12 +248,11 @@ def read_at2(filename, headonly: bool = False, **kwargs) -> Stream:
     if found is None:
         raise RecordError(name, "is not a PEER AT2 file (no PEER title and NPTS/DT header line)")
     npts_line, (npts, dt) = found
-    delta = check_delta(dt, name)
+    delta = check_sampling_interval(dt, name, "DT")
     header_lines = lines[: npts_line + 1]
     description = header_lines[1] if npts_line >= 2 else ""
     units_line = header_lines[npts_line - 1] if npts_line >= 2 else ""
-    unit, stated = _units(units_line, name)
-    factor = si_factor(unit, name)
+    unit, factor, stated = _units(units_line, name)
 
     tokens = [t.strip() for t in description.split(",")]
     component = tokens[-1] if len(tokens) >= 2 else ""
@@ -228,4 +300,5 @@ def read_at2(filename, headonly: bool = False, **kwargs) -> Stream:
     trace = make_trace(samples, delta, stats)
     check_samples(trace.data, name, "the acceleration record")
     trace.data *= factor
+    check_plausible_samples(trace.data, name, f"the acceleration record (in {unit})")
     return Stream([trace])

@@ -89,8 +89,9 @@ from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     CARDINAL_TOLERANCE_DEG,
     band_code,
-    check_delta,
+    check_plausible_samples,
     check_samples,
+    check_sampling_interval,
     fixed_fields,
     make_trace,
     orientation_stats,
@@ -410,8 +411,11 @@ def _read_block(cursor: _Lines, name: str, headonly: bool, horizontals: list):
 
     m = cursor.expect(_INT_HEADER, "integer-header")
     count, n_lines, per_line, width = (int(g) for g in m.groups())
-    ints = [int(v) for v in _fixed_width(cursor.take(n_lines, "integer header"), count,
-                                         per_line, width, name, "integer header")]
+    ints = _fixed_width(cursor.take(n_lines, "integer header"), count, per_line, width, name,
+                        "integer header")
+    if not all(math.isfinite(v) for v in ints):
+        raise RecordError(name, f"line {block_line}: the integer header holds NaN/inf")
+    ints = [int(v) for v in ints]
     m = cursor.expect(_REAL_HEADER, "real-header")
     count, n_lines, per_line, width = (int(g) for g in m.groups())
     reals = _fixed_width(cursor.take(n_lines, "real header"), count, per_line, width, name,
@@ -440,6 +444,7 @@ def _read_block(cursor: _Lines, name: str, headonly: bool, horizontals: list):
             factor = UNIT_CODES[code][1]
             if factor is not None:
                 trace.data *= factor
+                check_plausible_samples(trace.data, name, f"channel {trace.stats.channel}")
     if cursor.at_end() or not _END_OF_DATA.match(cursor.peek()):
         found = repr(cursor.peek()[:60]) if not cursor.at_end() else "the end of the file"
         raise RecordError(
@@ -507,7 +512,7 @@ def _make_trace(name, text, ints, reals, comments, nulls, data_line, code, unit_
     delta_ms = _value(reals, 62, real_null)
     if delta_ms is None:
         raise RecordError(name, "the sampling interval Real(62) is unknown")
-    delta = check_delta(delta_ms / 1000.0, name)
+    delta = check_sampling_interval(delta_ms / 1000.0, name)
     length = _value(reals, 63, real_null)
     if length is not None and abs(length / delta - npts) > 1.0:
         notes.append(f"Real(63) record length {length:g} s is not {npts} samples of {delta:g} s")

@@ -90,9 +90,9 @@ from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
     canonical_unit,
-    check_delta,
     check_plausible_samples,
     check_samples,
+    check_sampling_interval,
     fixed_fields,
     make_trace,
     orientation_stats,
@@ -689,7 +689,7 @@ def _read_channel(volume, start, block, has_marker, name, headonly, resample_int
                 dt *= PAIR_TIME_RESOLUTION_S
             else:
                 dt = float(resample_interval)
-            dt = check_delta(dt, name)
+            dt = check_sampling_interval(dt, name)
             count = int(math.floor((times[-1] - times[0]) / dt + 1e-6)) + 1
             if count > MAX_RESAMPLE_FACTOR * npts:
                 raise RecordError(name, f"channel {number}: resampling {npts} pairs at {dt} s"
@@ -702,7 +702,7 @@ def _read_channel(volume, start, block, has_marker, name, headonly, resample_int
             npts = count
     else:
         data = values
-    delta = check_delta(dt, name)
+    delta = check_sampling_interval(dt, name)
     check_samples(data, name, f"channel {number} acceleration")
 
     # Stated peak, checked against the samples.

@@ -37,6 +37,7 @@ References
 
 from __future__ import annotations
 
+import math
 import re
 import warnings
 
@@ -46,8 +47,9 @@ from obspy.core import AttribDict
 
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
-    check_delta,
+    check_plausible_samples,
     check_samples,
+    check_sampling_interval,
     make_trace,
     parse_float,
     parse_free_floats,
@@ -129,11 +131,14 @@ def _float(header, key, name, required=True):
             raise RecordError(name, f"header key {key} is missing or empty")
         return None
     try:
-        return parse_float(raw)
+        value = parse_float(raw)
     except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
         if required:
-            raise RecordError(name, f"header key {key}={raw!r} is not a number") from None
+            raise RecordError(name, f"header key {key}={raw!r} is not a finite number")
         return None
+    return value
 
 
 def _start_time(raw: str) -> UTCDateTime | None:
@@ -208,7 +213,7 @@ def read_esm(filename, headonly: bool = False, **kwargs) -> Stream:
     data_type = header.get("DATA_TYPE", "")
     if data_type and ("ACC" not in data_type.upper() or "SPECTR" in data_type.upper()):
         raise UnitsError(name, f"DATA_TYPE is {data_type!r}, not an acceleration time series")
-    delta = check_delta(_float(header, "SAMPLING_INTERVAL_S", name), name)
+    delta = check_sampling_interval(_float(header, "SAMPLING_INTERVAL_S", name), name)
     ndata = _float(header, "NDATA", name)
     if ndata != int(ndata) or ndata < 0:
         raise RecordError(name, f"NDATA={header['NDATA']!r} is not a sample count")
@@ -255,6 +260,7 @@ def read_esm(filename, headonly: bool = False, **kwargs) -> Stream:
     else:
         trace = make_trace(samples, delta, stats)
         trace.data *= factor
+        check_plausible_samples(trace.data, name, f"channel {stats['channel'] or '?'}")
         if pga is not None and not _peaks_agree(float(np.max(np.abs(trace.data))),
                                                 abs(pga) * PGA_KEY_TO_SI):
             note = (f"{PGA_KEY}={pga:g} disagrees with the samples' peak"

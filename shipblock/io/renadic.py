@@ -71,9 +71,9 @@ from obspy.core import AttribDict
 
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
-    check_delta,
     check_plausible_samples,
     check_samples,
+    check_sampling_interval,
     fixed_fields,
     make_trace,
     orientation_stats,
@@ -275,7 +275,7 @@ def _read_block(lines, start, name, number, headonly):
     if end >= len(lines) or not lines[end].lstrip().startswith("/&"):
         raise RecordError(name, f"{where} is truncated: no '/& END OF DATA' line")
     npts = header["npts"]
-    delta = check_delta(header["record_length_s"] / npts, name)
+    delta = check_sampling_interval(header["record_length_s"] / npts, name)
     data = None
     if not headonly:
         values = _parse_pairs(lines[data_start:end], name, where)

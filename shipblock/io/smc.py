@@ -67,8 +67,9 @@ from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     DEFAULT_RESAMPLE_RATE_HZ,
     FLOAT_RE,
-    check_delta,
+    check_plausible_samples,
     check_samples,
+    check_sampling_interval,
     fixed_fields,
     horizontal_index,
     make_trace,
@@ -440,7 +441,7 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
         raw_peak = float(np.max(np.abs(data[1::2])))
     else:
         samples = data
-        delta = check_delta(1.0 / rate, name)
+        delta = check_sampling_interval(1.0 / rate, name)
         raw_peak = float(np.max(np.abs(data)))
     sampling_rate = 1.0 / delta
 
@@ -506,6 +507,7 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
         trace.stats.npts = len(samples)
     else:
         trace.data *= factor
+        check_plausible_samples(trace.data, name, "the record")
     if start is not None:
         trace.stats.starttime = start + first_time
     return Stream([trace])

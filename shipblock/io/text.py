@@ -25,8 +25,9 @@ from obspy.core import AttribDict
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     canonical_unit,
-    check_delta,
+    check_plausible_samples,
     check_samples,
+    check_sampling_interval,
     make_trace,
     parse_float,
     peek_text,
@@ -264,7 +265,7 @@ def read_text_record(
         delta = dt if dt is not None else _header_dt(header)
         if delta is None:
             raise RecordError(name, "one-column record: the sampling interval is unknown; pass dt=")
-    delta = check_delta(delta, name)
+    delta = check_sampling_interval(delta, name)
     start = UTCDateTime(starttime) if starttime is not None else UTCDateTime(0) + t0
     stats = {
         "network": network,
@@ -286,4 +287,5 @@ def read_text_record(
     trace = make_trace(accel, delta, stats)
     check_samples(trace.data, name, "the acceleration column")
     trace.data *= factor
+    check_plausible_samples(trace.data, name, f"the acceleration column (in {unit})")
     return Stream([trace])

@@ -61,9 +61,9 @@ from obspy.core import AttribDict
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
-    check_delta,
     check_plausible_samples,
     check_samples,
+    check_sampling_interval,
     fixed_fields,
     make_trace,
     orientation_stats,
@@ -424,12 +424,12 @@ def read_unam(filename, headonly: bool = False, **kwargs) -> Stream:
         rate_raw = rates_text[channel] if channel < len(rates_text) else ""
         rate = parse_number(rate_raw, name, "VEL. DE MUESTREO") if rate_raw else None
         if delta_raw:
-            delta = check_delta(parse_number(delta_raw, name, "INTERVALO DE MUESTREO"), name)
+            delta = check_sampling_interval(parse_number(delta_raw, name, "INTERVALO DE MUESTREO"), name)
             if rate is not None and abs(rate * delta - 1.0) > _RATE_TOLERANCE:
                 raise RecordError(name, f"channel {channel + 1}: sampling interval {delta} s"
                                         f" and sampling rate {rate} /s disagree")
         elif rate is not None and rate > 0:
-            delta = check_delta(1.0 / rate, name)
+            delta = check_sampling_interval(1.0 / rate, name)
         else:
             raise RecordError(name, f"channel {channel + 1} has no sampling interval or rate")
         deltas.append(delta)

@@ -71,8 +71,9 @@ from shipblock.io._common import (
     DEFAULT_RESAMPLE_RATE_HZ,
     FLOAT_RE,
     canonical_unit,
-    check_delta,
+    check_plausible_samples,
     check_samples,
+    check_sampling_interval,
     fixed_fields,
     horizontal_index,
     make_trace,
@@ -396,7 +397,7 @@ def _read_v2(lines, start, name, headonly):
             " IN UNITS ...' line"
         )
     npts, dt, unit = int(match.group(1)), parse_float(match.group(2)), match.group(3).rstrip(".")
-    delta = check_delta(dt, name)
+    delta = check_sampling_interval(dt, name)
     factor = _units_factor(unit, name)
     if npts <= 0:
         raise RecordError(name, f"acceleration block states {npts} points")
@@ -481,6 +482,7 @@ def _trace(samples, delta, factor, unit, header, ints, text, name, headonly):
         trace.stats.npts = len(samples)
     else:
         trace.data *= factor
+        check_plausible_samples(trace.data, name, f"channel {trace.stats.channel}")
     trace.stats.starttime = _start_time(ints, name)
     return trace
 
