@@ -4,8 +4,16 @@ and they stay ValueErrors for code that expects the conventional type."""
 import numpy as np
 import pytest
 
-from shipblock import RecordSet, ShipBlockSystem, intensity, scaling, simulate, simulate_batch
-from shipblock.errors import ParameterError, RecordError, ShipblockError
+from shipblock import (
+    RecordSet,
+    ShipBlockSystem,
+    intensity,
+    scaling,
+    simulate,
+    simulate_batch,
+    system_restitution,
+)
+from shipblock.errors import ParameterError, ParameterTypeError, RecordError, ShipblockError
 from shipblock.fragility.design import AnalysisDesign, IntensityDesign
 from shipblock.fragility.fit import fit_mle
 from shipblock.fragility.limit_states import LimitState
@@ -67,13 +75,136 @@ CASES = {
 }
 
 
-def test_batch_finiteness_check_has_no_false_alarm():
-    """simulate_batch checks finiteness on the sum of all records: finite samples whose sum
-    overflows must still run (the check falls back to sample by sample)."""
-    huge = np.full(4, 1e308)
-    out = simulate_batch(ShipBlockSystem.example(), [(ACC, None), (huge, None)], 0.01,
-                         [[0, 0, 1.0, 1.0]])
-    assert np.isfinite(out["peak_block_slip"]).all()
+def _motion(dt=0.01):
+    from shipblock.motion import GroundMotion
+
+    return GroundMotion.from_arrays(ACC, None, dt=dt, name="sine")
+
+
+EX = ShipBlockSystem.example()
+BATCH = dict(records=[(ACC, None)], dts=0.01, cases=[[0, 0, 1.0, 1.0]])
+
+# The inputs of issue #23 (a fuzz campaign of bad API calls): each must end in a shipblock error
+# that names the argument, not in a numba TypingError, an OverflowError, "too many values to
+# unpack", a float() error or a NaN result.
+ISSUE_23 = {
+    "n_blocks nan": (lambda: EX.replace(n_blocks=float("nan")), "n_blocks"),
+    "n_blocks inf": (lambda: EX.replace(n_blocks=float("inf")), "n_blocks"),
+    "n_blocks None": (lambda: EX.replace(n_blocks=None), "n_blocks"),
+    "n_blocks bool": (lambda: EX.replace(n_blocks=True), "n_blocks"),
+    "mu None": (lambda: EX.replace(mu_s_ground=None), "mu_s_ground"),
+    "mu string": (lambda: EX.replace(mu_k_ship="0.3"), "mu_k_ship"),
+    "restitution string": (lambda: EX.replace(restitution="high"), "restitution"),
+    "block_inertia list": (lambda: EX.replace(block_inertia=[1.0]), "block_inertia"),
+    "block_inertia above m R^2": (lambda: EX.replace(block_inertia=1e9), "block_inertia"),
+    "ship_mass 1e300": (lambda: EX.replace(ship_mass=1e300), "ship_mass"),
+    "half_width 1e-300": (lambda: EX.replace(half_width=1e-300), "half_width"),
+    "g huge int": (lambda: EX.replace(g=10**400), "g"),
+    "impact_rule None": (lambda: EX.replace(impact_rule=None), "impact_rule"),
+    "batch without systems": (lambda: simulate_batch([], **BATCH), "systems"),
+    "batch empty systems and cases": (lambda: simulate_batch(systems=[], records=[(ACC, None)],
+                                                             dts=0.01, cases=[]), "systems"),
+    "batch system not a system": (lambda: simulate_batch([EX, "x"], **BATCH), "systems[1]"),
+    "batch without records": (lambda: simulate_batch(EX, [], 0.01, []), "records"),
+    "batch bare array record": (lambda: simulate_batch(EX, [ACC], 0.01, [[0, 0, 1.0, 1.0]]),
+                                "records[0] must be a pair (ax, ay)"),
+    "batch record as a 2-D array": (lambda: simulate_batch(EX, [np.stack([ACC, ACC])], 0.01,
+                                                           [[0, 0, 1.0, 1.0]]), "records[0]"),
+    "batch dts string": (lambda: simulate_batch(EX, [(ACC, None)], "0.01", [[0, 0, 1, 1]]),
+                         "dts"),
+    "batch cases string": (lambda: simulate_batch(EX, [(ACC, None)], 0.01, "all"), "cases"),
+    "batch scale 1e300": (lambda: simulate_batch(EX, [(ACC, None)], 0.01, [[0, 0, 1e300, 1.0]]),
+                          "cases[0, 2] (horizontal scale)"),
+    "batch vertical scaled above 100 g": (lambda: simulate_batch(EX, [(ACC, ACC)], 0.01,
+                                                                 [[0, 0, 1.0, 1e3]]),
+                                          "cases[0, 3] (vertical scale)"),
+    "batch record of 1e308": (lambda: simulate_batch(EX, [(ACC, None), (np.full(4, 1e308), None)],
+                                                     0.01, [[0, 0, 1.0, 1.0]]),
+                              "records[1] horizontal"),
+    "batch rtol string": (lambda: simulate_batch(EX, **BATCH, rtol="1e-8"), "rtol"),
+    "simulate GroundMotion with dt": (lambda: simulate(EX, _motion(), dt=0.01), "dt"),
+    "simulate GroundMotion with ay": (lambda: simulate(EX, _motion(), ACC), "ay"),
+    "simulate dt 1e300": (lambda: simulate(EX, ACC, None, 1e300), "dt"),
+    "simulate dt 1e-300": (lambda: simulate(EX, ACC, None, 1e-300), "dt"),
+    "simulate dt string": (lambda: simulate(EX, ACC, None, "0.01"), "dt"),
+    "simulate ax 1e300": (lambda: simulate(EX, ACC * 1e300, None, 0.01), "ax"),
+    "simulate ay 1e300": (lambda: simulate(EX, ACC, ACC * 1e300, 0.01), "ay"),
+    "simulate ax above 100 g": (lambda: simulate(EX, ACC * 1000.0, None, 0.01), "100 g"),
+    "simulate ax string": (lambda: simulate(EX, "ACC", None, 0.01), "ax"),
+    "simulate ax complex": (lambda: simulate(EX, ACC + 1j, None, 0.01), "ax"),
+    "simulate ax 2-D": (lambda: simulate(EX, np.stack([ACC, ACC]), None, 0.01), "ax"),
+    "simulate system None": (lambda: simulate(None, ACC, None, 0.01), "system"),
+    "simulate rtol nan": (lambda: simulate(EX, ACC, None, 0.01, rtol=float("nan")), "rtol"),
+    "simulate rtol 1e-300": (lambda: simulate(EX, ACC, None, 0.01, rtol=1e-300), "rtol"),
+    "simulate atol string": (lambda: simulate(EX, ACC, None, 0.01, atol="tight"), "atol"),
+    "simulate atol inf": (lambda: simulate(EX, ACC, None, 0.01, atol=float("inf")), "atol"),
+    "simulate zeno_omega negative": (lambda: simulate(EX, ACC, None, 0.01, zeno_omega=-1.0),
+                                     "zeno_omega"),
+    "simulate initial_state string": (lambda: simulate(EX, ACC, None, 0.01, initial_state="rest"),
+                                      "initial_state"),
+    "simulate initial_state short": (lambda: simulate(EX, ACC, None, 0.01, initial_state=[0, 0]),
+                                     "initial_state"),
+    "simulate initial_state 1e300 velocity": (
+        lambda: simulate(EX, ACC, None, 0.01, initial_state=[0, 0, 0, 1e300, 0, 0]),
+        "initial_state v_b"),
+    "simulate initial_state beyond critical": (
+        lambda: simulate(EX, ACC, None, 0.01, initial_state=[0, 2.0, 0, 0, 0, 0]),
+        "initial_state theta"),
+    "restitution of the system: alpha": (lambda: system_restitution(0.1, float("nan")), "alpha"),
+    "restitution of the system: mass_ratio": (lambda: system_restitution("x", 0.2),
+                                              "mass_ratio"),
+}
+
+
+def test_records_at_the_plausibility_limit_run():
+    """Exactly 100 g (as given, or a case scaled to it) is accepted and gives finite results;
+    the check does not depend on a sum of the samples (no overflow false alarm)."""
+    from shipblock.checks import MAX_ACCELERATION
+
+    peak = ACC / np.abs(ACC).max() * MAX_ACCELERATION
+    res = simulate(EX, peak, None, 0.01)
+    assert np.isfinite(res.x_b).all() and np.isfinite(res.summary["peak_block_slip"])
+    out = simulate_batch(EX, [(ACC, None)] * 3, 0.01,
+                         [[0, 0, MAX_ACCELERATION / np.abs(ACC).max(), 1.0]])
+    assert out["peak_block_slip"][0] == res.summary["peak_block_slip"]
+
+
+def test_empty_cases_give_empty_results():
+    out = simulate_batch(EX, [(ACC, None)], 0.01, np.zeros((0, 4)))
+    assert out["peak_block_slip"].shape == (0,)
+    assert simulate_batch(EX, [(ACC, None)], 0.01, [])["failure"].shape == (0,)
+
+
+@pytest.mark.parametrize("case", list(ISSUE_23))
+def test_issue_23_api_inputs_raise_a_named_error(case):
+    make, named = ISSUE_23[case]
+    with pytest.raises(ParameterError) as info:
+        make()
+    assert named in str(info.value), str(info.value)
+    if isinstance(info.value, ParameterTypeError):
+        assert isinstance(info.value, TypeError) and isinstance(info.value, ValueError)
+
+
+def test_a_wrong_type_is_also_a_type_error():
+    with pytest.raises(TypeError, match="n_blocks"):
+        EX.replace(n_blocks="many")
+    with pytest.raises(TypeError, match="records\\[0\\]"):
+        simulate_batch(EX, [ACC], 0.01, [[0, 0, 1.0, 1.0]])
+
+
+def test_whole_float_n_blocks_is_kept_as_an_int():
+    system = EX.replace(n_blocks=120.0)
+    assert system.n_blocks == 120 and isinstance(system.n_blocks, int)
+
+
+def test_solver_limits_equal_the_readers_limits():
+    """What a reader accepts the solver runs: the same plausibility limits."""
+    from shipblock import checks
+    from shipblock.io import _common
+
+    assert checks.MAX_ACCELERATION == _common.MAX_ACCELERATION_SI
+    assert checks.MIN_TIME_STEP == _common.MIN_SAMPLING_INTERVAL_S
+    assert checks.MAX_TIME_STEP == _common.MAX_SAMPLING_INTERVAL_S
 
 
 @pytest.mark.parametrize("case", list(CASES))
