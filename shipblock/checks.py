@@ -26,8 +26,11 @@ from shipblock.units import STANDARD_GRAVITY
 
 __all__ = [
     "MAX_ACCELERATION",
+    "MAX_DURATION",
+    "MAX_PADDING",
     "MAX_PERIOD",
     "MAX_TIME_STEP",
+    "MIN_PERIOD",
     "MIN_TIME_STEP",
     "acceleration",
     "choice",
@@ -45,8 +48,17 @@ MAX_ACCELERATION = 100.0 * STANDARD_GRAVITY
 MIN_TIME_STEP = 1e-4
 MAX_TIME_STEP = 1.0
 
-#: Longest oscillator period of a response spectrum or a scaling measure [s].
+#: Range of oscillator periods of a response spectrum or a scaling measure [s] (a period of 0,
+#: where a spectrum takes one, stands for PGA; below the finest sampling interval the
+#: oscillator is rigid).
+MIN_PERIOD = 1e-4
 MAX_PERIOD = 100.0
+
+#: Longest time a record is trimmed at [s] (a day; no earthquake record is longer).
+MAX_DURATION = 86_400.0
+
+#: Longest zero padding added to either end of a record [s].
+MAX_PADDING = 600.0
 
 _REAL_TYPES = (int, float, np.integer, np.floating)
 
@@ -173,7 +185,9 @@ def time_step(dt, name: str = "dt") -> float:
     ParameterTypeError, ParameterError
         Naming ``name``.
     """
-    return real(dt, name, low=MIN_TIME_STEP, high=MAX_TIME_STEP, units="s")
+    # a relative slack of 1e-9: an interval computed as 1 / 10 kHz may round below 1e-4
+    return real(dt, name, low=MIN_TIME_STEP * (1.0 - 1e-9), high=MAX_TIME_STEP * (1.0 + 1e-9),
+                units="s")
 
 
 def acceleration(values, name: str, *, limit: float = MAX_ACCELERATION,
@@ -206,20 +220,24 @@ def acceleration(values, name: str, *, limit: float = MAX_ACCELERATION,
     """
     arr = as_real_array(values, name, "a one-dimensional array of accelerations [m/s^2]")
     if arr.ndim != 1:
-        raise ParameterError(f"{name} must be a one-dimensional array, got shape {arr.shape}")
+        raise ParameterError(f"{name} must be a one-dimensional (1-D) array, got shape "
+                             f"{arr.shape}")
     if arr.size < min_samples:
         raise ParameterError(f"{name} must have at least {min_samples} samples, got {arr.size}")
     check_samples(arr, name, limit)
     return np.ascontiguousarray(arr)
 
 
-def as_real_array(values, name: str, what: str) -> np.ndarray:
-    """``values`` as a float64 array, or a :class:`ParameterTypeError` naming ``name``."""
+def as_real_array(values, name: str, what: str, kinds: str = "iuf") -> np.ndarray:
+    """``values`` as a float64 array, or a :class:`ParameterTypeError` naming ``name``.
+
+    ``kinds`` are the NumPy dtype kinds accepted (``"b"`` added for true/false arrays).
+    """
     if values is None or isinstance(values, str | bytes | dict | set):
         raise ParameterTypeError(f"{name} must be {what}, got {type(values).__name__}")
     try:
         arr = np.asarray(values)
-        if arr.dtype.kind not in "iuf":
+        if arr.dtype.kind not in kinds:
             raise TypeError(f"elements of type {arr.dtype}")
         return arr.astype(np.float64, copy=False)
     except (TypeError, ValueError) as exc:
@@ -239,6 +257,6 @@ def check_samples(arr: np.ndarray, name: str, limit: float = MAX_ACCELERATION) -
         i = int(np.flatnonzero(bad)[0])
         what = "non-finite" if not np.isfinite(arr[i]) else f"above {limit / STANDARD_GRAVITY:g} g"
         raise ParameterError(
-            f"{name} has {int(bad.sum())} sample(s) non-finite or above the plausibility limit "
-            f"{limit:g} m/s^2 ({limit / STANDARD_GRAVITY:g} g); the first is {float(arr[i])!r} at index "
-            f"{i} ({what})")
+            f"{name} has {int(bad.sum())} sample(s) that are NaN, infinite or above the "
+            f"plausibility limit {limit:g} m/s^2 ({limit / STANDARD_GRAVITY:g} g); the first is "
+            f"{float(arr[i])!r} at index {i} ({what})")

@@ -51,9 +51,12 @@ FIELD_LIMITS: dict[str, tuple[float | None, float | None, str]] = {
     "mu_s_ship": (0.0, 100.0, ""),
     "mu_k_ship": (0.0, 100.0, ""),
     "restitution": (0.0, 1.0, ""),
-    "block_inertia": (0.0, None, "kg m^2"),  # > 0 and at most m (B^2 + H^2)
+    "block_inertia": (0.0, None, "kg m^2"),  # and MIN_INERTIA_RATIO .. 1 times m (B^2 + H^2)
     "g": (0.1, 100.0, "m/s^2"),
 }
+
+#: Smallest ratio I / (m R^2) of a block_inertia given explicitly [-] (1/3 for a uniform block).
+MIN_INERTIA_RATIO = 1e-6
 
 
 def system_restitution(mass_ratio: float, alpha: float, inertia_ratio: float = 1.0 / 3.0) -> float:
@@ -139,7 +142,8 @@ class ShipBlockSystem:
     ParameterError
         For a value outside its range in :data:`FIELD_LIMITS` (non-finite, a non-positive mass
         or size, negative friction...), a kinetic coefficient above the static one, a
-        ``block_inertia`` above :math:`m(B^2+H^2)` or an unknown impact rule. Both are
+        ``block_inertia`` outside :data:`MIN_INERTIA_RATIO` .. 1 times :math:`m(B^2+H^2)` or
+        an unknown impact rule. Both are
         :class:`ValueError`; the message names the field and what it expects.
     """
 
@@ -177,12 +181,14 @@ class ShipBlockSystem:
                 )
         choice(self.impact_rule, "impact_rule", IMPACT_RULES)
         if self.block_inertia is not None:
-            # every point of a block lies within R of its centroid: I <= m R^2
+            # every point of a block lies within R of its centroid: I <= m R^2; far below
+            # MIN_INERTIA_RATIO m R^2 the block is a point mass and the ratio underflows
             most = self.block_mass * (self.half_width**2 + self.half_height**2)
-            if self.block_inertia > most:
+            if not MIN_INERTIA_RATIO * most <= self.block_inertia <= most:
                 raise ParameterError(
-                    f"block_inertia must not exceed block_mass * (half_width^2 + half_height^2) "
-                    f"= {most:g} kg m^2 (all the mass at the corners), got {self.block_inertia!r}"
+                    f"block_inertia must lie between {MIN_INERTIA_RATIO:g} and 1 times "
+                    f"block_mass * (half_width^2 + half_height^2) = {most:g} kg m^2 (all the "
+                    f"mass at the corners), got {self.block_inertia!r}"
                 )
 
     # Derived quantities ------------------------------------------------------------------

@@ -97,6 +97,7 @@ ISSUE_23 = {
     "restitution string": (lambda: EX.replace(restitution="high"), "restitution"),
     "block_inertia list": (lambda: EX.replace(block_inertia=[1.0]), "block_inertia"),
     "block_inertia above m R^2": (lambda: EX.replace(block_inertia=1e9), "block_inertia"),
+    "block_inertia denormal": (lambda: EX.replace(block_inertia=5e-324), "block_inertia"),
     "ship_mass 1e300": (lambda: EX.replace(ship_mass=1e300), "ship_mass"),
     "half_width 1e-300": (lambda: EX.replace(half_width=1e-300), "half_width"),
     "g huge int": (lambda: EX.replace(g=10**400), "g"),
@@ -215,3 +216,127 @@ def test_bad_input_raises_a_named_shipblock_error(case):
     assert isinstance(info.value, ValueError)
     assert isinstance(info.value, ParameterError | RecordError)
     assert named in str(info.value), str(info.value)
+
+
+# -------------------------------------------------------------------------------------------
+# every public function of intensity, scaling, processing and fit, every argument, garbage
+# -------------------------------------------------------------------------------------------
+
+
+def _stream():
+    from obspy import Stream, Trace
+
+    tr = Trace(2.0 * np.sin(np.linspace(0.0, 20.0, 400)))
+    tr.stats.delta = 0.01
+    return Stream([tr])
+
+
+def _public_calls():
+    from shipblock import processing as P
+    from shipblock.fragility import fit as F
+
+    acc = 2.0 * np.sin(np.linspace(0.0, 20.0, 400))
+    acc2 = np.cos(np.linspace(0.0, 20.0, 400))
+    exceeded = np.array([[0, 0, 1], [0, 1, 1], [0, 1, 1], [1, 1, 1]], dtype=bool)
+    I, S = intensity, scaling  # noqa: N806
+    return {
+        "velocity": (I.velocity, dict(acc=acc, dt=0.01)),
+        "displacement": (I.displacement, dict(acc=acc, dt=0.01)),
+        "pga": (I.pga, dict(acc=acc, dt=0.01)),
+        "pgv": (I.pgv, dict(acc=acc, dt=0.01)),
+        "pgd": (I.pgd, dict(acc=acc, dt=0.01)),
+        "arias_intensity": (I.arias_intensity, dict(acc=acc, dt=0.01)),
+        "husid": (I.husid, dict(acc=acc, dt=0.01)),
+        "significant_duration": (I.significant_duration,
+                                 dict(acc=acc, dt=0.01, start=0.05, end=0.95)),
+        "cav": (I.cav, dict(acc=acc, dt=0.01)),
+        "cav5": (I.cav5, dict(acc=acc, dt=0.01, threshold=0.05)),
+        "sdof_response": (I.sdof_response, dict(acc=acc, dt=0.01, period=0.5, damping=0.05)),
+        "response_spectrum": (I.response_spectrum,
+                              dict(acc=acc, dt=0.01, periods=[0.1, 0.5], damping=0.05)),
+        "spectral_acceleration": (I.spectral_acceleration,
+                                  dict(acc=acc, dt=0.01, periods=[0.1, 0.5], damping=0.05)),
+        "intensity_measures": (I.intensity_measures,
+                               dict(acc=acc, dt=0.01, periods=[0.1, 0.5], damping=0.05)),
+        "intensity_measures_hv": (I.intensity_measures_hv,
+                                  dict(horizontal=acc, vertical=acc2, dt=0.01)),
+        "measure_value": (S.measure_value,
+                          dict(acc=acc, dt=0.01, measure="sa", period=0.5, damping=0.05)),
+        "amplitude_factor": (S.amplitude_factor, dict(acc=acc, dt=0.01, target=3.0)),
+        "scale": (S.scale, dict(acc=acc, factor=2.0)),
+        "scale_record": (S.scale_record,
+                         dict(horizontal=acc, vertical=acc2, dt=0.01, target=3.0)),
+        "polynomial_baseline": (P.polynomial_baseline, dict(acc=acc, dt=0.01, order=4)),
+        "apply_chain": (P.apply_chain, dict(stream=_stream(), chain=[{"step": "demean"}])),
+        "highpass": (P.highpass, dict(stream=_stream(), freq=0.1, corners=4, zerophase=True)),
+        "lowpass": (P.lowpass, dict(stream=_stream(), freq=20.0, corners=4)),
+        "bandpass": (P.bandpass, dict(stream=_stream(), freqmin=0.1, freqmax=20.0)),
+        "taper": (P.taper, dict(stream=_stream(), max_percentage=0.05, type="hann",
+                                side="both")),
+        "detrend": (P.detrend, dict(stream=_stream(), type="linear")),
+        "resample": (P.resample, dict(stream=_stream(), sampling_rate=50.0)),
+        "trim": (P.trim, dict(stream=_stream(), start=0.5, end=2.0)),
+        "pad": (P.pad, dict(stream=_stream(), before=1.0, after=1.0)),
+        "baseline": (P.baseline, dict(stream=_stream(), order=4)),
+        "lognormal_fragility": (F.lognormal_fragility, dict(x=[0.1, 1.0], median=0.5, beta=0.4)),
+        "fit_mle": (F.fit_mle, dict(im_levels=[1.0, 2.0, 3.0], n_exceed=[1, 3, 8],
+                                    n_total=[10, 10, 10])),
+        "fit_msa": (F.fit_msa, dict(exceeded=exceeded, im_levels=[1.0, 2.0, 3.0])),
+        "ida_capacities": (F.ida_capacities, dict(exceeded=exceeded, im_levels=[1.0, 2.0, 3.0])),
+        "fit_ida": (F.fit_ida, dict(capacities=[1.0, 2.0, 3.0, 1.5, 2.5], method="mle")),
+        "fit_cloud": (F.fit_cloud, dict(im=[1.0, 2.0, 3.0, 4.0, 5.0, 6.0],
+                                        edp=[0.1, 0.3, 0.2, 0.6, 0.5, 1.0], capacity=0.4,
+                                        method="regression")),
+        "bootstrap": (F.bootstrap, dict(fit_function=F.fit_ida,
+                                        records={"capacities": np.array([1.0, 2.0, 3.0, 1.5,
+                                                                         2.5])},
+                                        n_boot=10, confidence=0.9, seed=1)),
+    }
+
+
+GARBAGE = {"None": None, "string": "abc", "nan": float("nan"), "inf": float("inf"),
+           "negative": -1.0, "zero": 0.0, "1e300": 1e300, "1e-300": 1e-300, "empty list": [],
+           "2-D list": [[1.0, 2.0], [3.0, 4.0]], "bool": True, "object": object(),
+           "array with NaN": np.array([np.nan, 1.0, 2.0])}
+
+
+def _finite(value) -> bool:
+    from obspy import Stream
+
+    parts = value if isinstance(value, tuple) else (value,)
+    try:
+        return all(np.isfinite(np.asarray(p, dtype=float)).all() for p in parts
+                   if not isinstance(p, str | Stream))
+    except (TypeError, ValueError):
+        return True  # a result object (ScaledRecord, FragilityFit...): not an array
+
+
+@pytest.mark.filterwarnings("ignore")
+@pytest.mark.parametrize("function", list(_public_calls()))
+def test_every_public_function_accepts_or_names_a_bad_argument(function):
+    """The issue's rule for every public function: each argument replaced in turn by garbage
+    gives a finite result or an error that names that argument: a shipblock error, or a
+    TypeError that names it - never a numpy or float() error, an OverflowError or NaN."""
+    from obspy import Stream
+
+    fn, good = _public_calls()[function]
+    fn(**{k: (v.copy() if isinstance(v, Stream) else v) for k, v in good.items()})
+    problems = []
+    for arg in good:
+        for label, bad in GARBAGE.items():
+            args = {k: (v.copy() if isinstance(v, Stream) else v) for k, v in good.items()}
+            args[arg] = bad
+            try:
+                out = fn(**args)
+            except (ShipblockError, TypeError) as exc:
+                message = str(exc)
+                names = {arg, "acceleration"} if arg == "acc" else {arg}
+                if not any(n in message for n in names):
+                    problems.append(f"{arg}={label}: {type(exc).__name__} does not name it: "
+                                    f"{message}")
+            except Exception as exc:  # noqa: BLE001 - the failure under test
+                problems.append(f"{arg}={label}: {type(exc).__name__}: {exc}")
+            else:
+                if not _finite(out):
+                    problems.append(f"{arg}={label}: accepted with a non-finite result")
+    assert not problems, "\n".join(problems)

@@ -361,7 +361,7 @@ LEVELS = "levels_g = [0.2, 0.4, 0.5, 0.6, 0.8]"
                                               "vertical_levels_g = [1e6, 1, 1, 1, 1]"),
          "design.vertical_levels_g", "vertical_levels_g[0]"),
         (lambda t: t.replace('type = "ida"', 'type = "ida"\nmeasure = "sa"\nperiod = 1e300'),
-         "design.period", "(0, 100]"),
+         "design.period", "[0.0001, 100]"),
         (lambda t: t.replace("bootstrap = 20", "bootstrap = 1000000000000"), "fit.bootstrap",
          "[0, 10000]"),
         (lambda t: t.replace("bootstrap = 20", "bootstrap = 1e12"), "fit.bootstrap",

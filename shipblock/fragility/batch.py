@@ -31,8 +31,6 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
-from shipblock.checks import MAX_ACCELERATION
-from shipblock.errors import ParameterError
 from shipblock.fragility.design import AnalysisDesign, IntensityDesign
 from shipblock.fragility.store import RUN_VARIABLES, ChunkStore, StoreError
 from shipblock.modes import Failure
@@ -42,7 +40,6 @@ from shipblock.solver import (
     DEFAULT_ZENO_OMEGA,
     simulate_batch,
 )
-from shipblock.units import STANDARD_GRAVITY
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
@@ -137,23 +134,6 @@ def _failed(record_id: str, n_levels: int, error: str, metadata=None) -> Prepare
                           nan.copy(), float("nan"), dict(metadata or {}), error)
 
 
-def _check_scaled_peaks(h, v, factor_h, factor_v) -> None:
-    """Refuse a record that some level scales above :data:`shipblock.checks.MAX_ACCELERATION`.
-
-    A level of Sa or PGV can need a peak acceleration no ground motion has (100 g); the solver
-    would refuse the run, so the record is left out with this reason instead.
-    """
-    for label, acc, factors in (("horizontal", h, factor_h), ("vertical", v, factor_v)):
-        if acc is None:
-            continue
-        peaks = np.abs(factors) * np.abs(acc).max()
-        if not (peaks <= MAX_ACCELERATION).all():
-            j = int(np.argmax(~(peaks <= MAX_ACCELERATION)))
-            raise ParameterError(f"scaled to level {j} (factor {factors[j]:.6g}) its {label} "
-                                 f"peaks at {peaks[j] / STANDARD_GRAVITY:.6g} g, above the "
-                                 f"plausibility limit {MAX_ACCELERATION / STANDARD_GRAVITY:g} g")
-
-
 def prepare_record(
     record_id: str,
     load: Callable[[], object],
@@ -177,8 +157,9 @@ def prepare_record(
     Returns
     -------
     PreparedRecord
-        With ``error`` set (and no data) if reading, processing or scaling failed, or if a
-        level scales it above :data:`shipblock.checks.MAX_ACCELERATION` (100 g).
+        With ``error`` set (and no data) if reading, processing or scaling failed (also if a
+        level needs a scaled record above :data:`shipblock.checks.MAX_ACCELERATION`, 100 g,
+        which :func:`~shipblock.scaling.scale_record` refuses).
     """
     from shipblock.processing import process_motion
     from shipblock.scaling import measure_value, scale_record
@@ -204,7 +185,6 @@ def prepare_record(
                 fv[j] = s.factor_v
                 ach_v[j] = s.achieved_v
         im = measure_value(h, dt, intensity.measure, intensity.period, intensity.damping)
-        _check_scaled_peaks(h, v, fh, fv)
     except Exception as exc:  # noqa: BLE001 - a bad record is reported, the batch goes on
         message = f"{type(exc).__name__}: {exc}"
         logger.warning("record %s left out: %s", record_id, message)

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from shipblock.checks import MAX_PERIOD, choice, real, whole
+from shipblock.checks import MAX_PERIOD, MIN_PERIOD, choice, real, whole
 from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.intensity import DEFAULT_DAMPING
 from shipblock.system import FIELD_LIMITS, ShipBlockSystem
@@ -223,7 +223,7 @@ class IntensityDesign:
         Target IM levels in SI units of the measure ([m/s^2] for PGA and Sa, [m/s] for PGV),
         strictly increasing, each within :data:`IM_LEVEL_RANGE`; empty for a cloud.
     period : float or None
-        Oscillator period for ``measure="sa"`` [s], in (0, 100].
+        Oscillator period for ``measure="sa"`` [s], in [0.0001, 100].
     damping : float
         Fraction of critical damping for ``measure="sa"`` [-].
     vertical : {"same", "independent", "unscaled", "zero"}
@@ -285,7 +285,7 @@ class IntensityDesign:
         if self.measure == "sa":
             if self.period is None:
                 raise ParameterError("period [s] is required for measure 'sa'")
-            real(self.period, "period", low=0.0, high=MAX_PERIOD, low_open=True, units="s")
+            real(self.period, "period", low=MIN_PERIOD, high=MAX_PERIOD, units="s")
         elif self.period is not None:
             raise ParameterError(f"period applies only to measure 'sa', not {self.measure!r}")
         real(self.damping, "damping", low=0.0, high=1.0, high_open=True)

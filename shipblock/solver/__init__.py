@@ -153,7 +153,8 @@ def simulate(
     else:
         ay_arr = as_acceleration(ay, "ay")
         if ay_arr.size != ax.size:
-            raise ParameterError(f"ax and ay must have the same length, got {ax.size} and {ay_arr.size}")
+            raise ParameterError(f"ay must have the same length as ax ({ax.size} samples), got "
+                                 f"{ay_arr.size}")
         has_ay = True
     y_init = np.zeros(6)
     if initial_state is not None:
@@ -286,8 +287,8 @@ def _case_columns(cases, packed: RecordSet, n_systems: int):
                 if bad.any():
                     row = int(np.argmax(bad))
                     raise ParameterError(
-                        f"a case refers to a {what} index out of range: cases[{row}, {col}] is "
-                        f"{idx[col, row]}, with {n} {what}{'s' if n != 1 else ''}")
+                        f"cases[{row}, {col}] ({what} index) is {idx[col, row]}: out of range, "
+                        f"with {n} {what}{'s' if n != 1 else ''}")
         limit = checks.MAX_ACCELERATION * (1.0 + 1e-12)  # a record scaled to exactly 100 g runs
         for col, peaks, what in ((2, packed.peak_h, "horizontal"), (3, packed.peak_v, "vertical")):
             scaled = np.abs(columns[col]) * peaks[idx[0]]

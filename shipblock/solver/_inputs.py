@@ -151,7 +151,8 @@ class RecordSet:
                 raise ParameterError(f"dts must give one sample interval per record ({n_rec}), "
                                      f"got shape {dts_arr.shape}")
             for d in np.unique(dts_arr).tolist():  # each distinct interval once
-                if not checks.MIN_TIME_STEP <= d <= checks.MAX_TIME_STEP:
+                if not (checks.MIN_TIME_STEP * (1.0 - 1e-9) <= d
+                        <= checks.MAX_TIME_STEP * (1.0 + 1e-9)):
                     first = int(np.flatnonzero((dts_arr == d) | (np.isnan(dts_arr) & (d != d)))[0])
                     check_dt(d, f"dts[{first}] (record {first})")
         hs, vs, has_v = [], [], []
