@@ -233,6 +233,8 @@ def as_real_array(values, name: str, what: str, kinds: str = "iuf") -> np.ndarra
 
     ``kinds`` are the NumPy dtype kinds accepted (``"b"`` added for true/false arrays).
     """
+    if type(values) is np.ndarray and values.dtype == np.float64:
+        return values  # the common case, at no cost
     if values is None or isinstance(values, str | bytes | dict | set):
         raise ParameterTypeError(f"{name} must be {what}, got {type(values).__name__}")
     try:

@@ -433,6 +433,19 @@ def test_unknown_key_lists_the_known_keys(tmp_path):
     assert info.value.key == "fit.sede"
 
 
+def test_run_pipeline_arguments_are_named(tmp_path):
+    from shipblock.errors import ParameterTypeError
+
+    path = write_pipeline(tmp_path)
+    for kwargs, name in (({"path": None}, "path"), ({"path": 3}, "path"),
+                         ({"path": path, "output": 3}, "output"),
+                         ({"path": path, "timings": []}, "timings"),
+                         ({"path": path, "scheduler": 8786}, "scheduler")):
+        with pytest.raises(ParameterTypeError, match=f"^{name} must be"):
+            run_pipeline(progress=False, **kwargs)
+    assert _no_partial(tmp_path) == []
+
+
 def _no_partial(folder: Path) -> list:
     return sorted(p.name for p in folder.rglob("*.partial"))
 

@@ -106,7 +106,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from shipblock.errors import ParameterError, ShipblockError
+from shipblock.errors import ParameterError, ParameterTypeError, ShipblockError
 from shipblock.fragility.batch import (
     DEFAULT_CHUNK_SIZE,
     prepare_record,
@@ -538,9 +538,15 @@ def load_pipeline(path) -> Pipeline:
 
     Raises
     ------
+    ParameterTypeError
+        If ``path`` is not a path.
     PipelineError
-        If the file is missing, not TOML, or invalid; the message names the key.
+        If the file is missing, not a TOML text file, or invalid; the message names the file
+        and the key.
     """
+    if not isinstance(path, str | os.PathLike):
+        raise ParameterTypeError(f"path must be the pipeline file (a str or os.PathLike), got "
+                                 f"{type(path).__name__} {path!r}")
     path = Path(path)
     try:
         data = path.read_bytes()
@@ -1227,6 +1233,12 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     from shipblock.catalogue import load_catalogue
     from shipblock.processing import DEFAULT_CHAIN
 
+    for name, value, types, what in (("output", output, str | os.PathLike, "a file path"),
+                                     ("scheduler", scheduler, str, "a scheduler address"),
+                                     ("timings", timings, dict, "a dict")):
+        if value is not None and not isinstance(value, types):
+            raise ParameterTypeError(f"{name} must be {what} or None, got "
+                                     f"{type(value).__name__} {value!r}")
     clock = _StageClock(timings)
     pipe = load_pipeline(path)
     out_path = (pipe.output if output is None
