@@ -108,7 +108,6 @@ class RecordSet:
         Sample intervals [s].
     has_v : ndarray of bool, shape (n,)
         Whether each record has a vertical component.
-
     peak_h, peak_v : ndarray, shape (n,)
         Peak absolute acceleration of each record's horizontal and vertical [m/s^2] (0 without
         a vertical).
