@@ -8,7 +8,7 @@ input data.
 
 from __future__ import annotations
 
-__all__ = ["ParameterError", "RecordError", "ShipblockError", "UnitsError"]
+__all__ = ["ParameterError", "ParameterTypeError", "RecordError", "ShipblockError", "UnitsError"]
 
 
 class ShipblockError(Exception):
@@ -17,6 +17,14 @@ class ShipblockError(Exception):
 
 class ParameterError(ShipblockError, ValueError):
     """A parameter, option or input array is invalid; the message names it and its value."""
+
+
+class ParameterTypeError(ParameterError, TypeError):
+    """A parameter has the wrong type (a string for a number, a bare array for a pair...).
+
+    Also a :class:`TypeError`, the type Python code conventionally raises for it; the message
+    names the parameter and what it expects.
+    """
 
 
 class RecordError(ShipblockError, ValueError):

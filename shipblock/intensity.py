@@ -53,6 +53,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from shipblock import checks
 from shipblock.errors import ParameterError, RecordError
 from shipblock.units import STANDARD_GRAVITY
 
@@ -136,33 +137,35 @@ class ResponseSpectrum(NamedTuple):
 _SOURCE = "<array>"
 
 
-def _as_record(acc) -> np.ndarray:
-    """Return ``acc`` as a finite 1-D float64 array with at least 2 samples."""
-    arr = np.asarray(acc, dtype=np.float64)
-    if arr.ndim != 1:
-        raise RecordError(_SOURCE, f"acceleration must be a 1-D array, got shape {arr.shape}")
-    if arr.size < 2:
-        raise RecordError(_SOURCE, f"acceleration needs at least 2 samples, got {arr.size}")
-    if not np.all(np.isfinite(arr)):
-        raise RecordError(_SOURCE, "acceleration contains NaN or infinite values")
-    return arr
+def _as_record(acc, name: str = "acc") -> np.ndarray:
+    """``acc`` as a 1-D float64 array of at least 2 samples, each finite and within 100 g.
+
+    The checks and limits are those of :mod:`shipblock.checks`; the message names ``name``.
+    """
+    return checks.acceleration(acc, name)
 
 
 def _check_dt(dt) -> float:
-    dt = float(dt)
-    if not np.isfinite(dt) or dt <= 0.0:
-        raise RecordError(_SOURCE, f"time step dt must be a positive finite number [s], got {dt}")
-    return dt
+    """A sampling interval within :data:`shipblock.checks.MIN_TIME_STEP` .. ``MAX_TIME_STEP``."""
+    return checks.time_step(dt, "dt")
 
 
 def _check_damping(damping) -> float:
-    damping = float(damping)
-    if not (0.0 <= damping < 1.0):
-        raise ParameterError(
-            f"damping must be a fraction of critical in [0, 1) (under-damped oscillator), "
-            f"got {damping}"
-        )
-    return damping
+    """A fraction of critical damping in [0, 1) (under-damped oscillator)."""
+    return checks.real(damping, "damping", low=0.0, high=1.0, high_open=True)
+
+
+def _check_periods(periods) -> np.ndarray:
+    """Oscillator periods as a 1-D array, each 0 (PGA) or in [MIN_PERIOD, MAX_PERIOD] [s]."""
+    arr = np.atleast_1d(checks.as_real_array(periods, "periods", "periods [s]"))
+    if arr.ndim != 1:
+        raise ParameterError(f"periods must be a scalar or 1-D array, got shape {arr.shape}")
+    bad = ~((arr == 0.0) | ((arr >= checks.MIN_PERIOD) & (arr <= checks.MAX_PERIOD)))
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ParameterError(f"periods must be 0 (PGA) or in [{checks.MIN_PERIOD:g}, "
+                             f"{checks.MAX_PERIOD:g}] [s], got {float(arr[i])!r} at index {i}")
+    return arr
 
 
 # --------------------------------------------------------------------------------------------
@@ -378,7 +381,9 @@ def significant_duration(acc, dt, start=0.05, end=0.95) -> float:
     .. [1] Trifunac, M. D. and Brady, A. G. (1975). A study on the duration of strong
        earthquake ground motion. *Bull. Seismol. Soc. Am.* 65(3), 581-626.
     """
-    if not (0.0 <= start < end <= 1.0):
+    start = checks.real(start, "start", low=0.0, high=1.0)
+    end = checks.real(end, "end", low=0.0, high=1.0)
+    if not start < end:
         raise ParameterError(f"need 0 <= start < end <= 1, got start={start}, end={end}")
     h = husid(acc, dt)
     t = np.arange(h.size) * _check_dt(dt)
@@ -460,9 +465,8 @@ def cav5(acc, dt, threshold=CAV5_THRESHOLD) -> float:
     .. [2] EPRI (1988). Report NP-5930 (definition of CAV).
     """
     a = _as_record(acc)
-    threshold = float(threshold)
-    if not np.isfinite(threshold) or threshold < 0.0:
-        raise ParameterError(f"threshold must be a non-negative acceleration [m/s^2], got {threshold}")
+    threshold = checks.real(threshold, "threshold", low=0.0, high=checks.MAX_ACCELERATION,
+                            units="m/s^2")
     absa = np.abs(a)
     return float(np.trapezoid(np.where(absa >= threshold, absa, 0.0), dx=_check_dt(dt)))
 
@@ -563,9 +567,8 @@ def sdof_response(acc, dt, period, damping=DEFAULT_DAMPING):
     a_g = _as_record(acc)
     dt = _check_dt(dt)
     zeta = _check_damping(damping)
-    period = float(period)
-    if not np.isfinite(period) or period <= 0.0:
-        raise ParameterError(f"period must be positive and finite [s], got {period}")
+    period = checks.real(period, "period", low=checks.MIN_PERIOD, high=checks.MAX_PERIOD,
+                         units="s")
     omega = np.array([2.0 * np.pi / period])
     coef = [float(x[0]) for x in _nigam_jennings_coefficients(omega, zeta, dt)]
     a, b, c, d, ap, bp, cp, dp = coef
@@ -626,11 +629,7 @@ def response_spectrum(acc, dt, periods, damping=DEFAULT_DAMPING) -> ResponseSpec
     a_g = _as_record(acc)
     dt = _check_dt(dt)
     zeta = _check_damping(damping)
-    periods = np.atleast_1d(np.asarray(periods, dtype=np.float64))
-    if periods.ndim != 1:
-        raise ParameterError(f"periods must be a scalar or 1-D array, got shape {periods.shape}")
-    if not np.all(np.isfinite(periods)) or np.any(periods < 0.0):
-        raise ParameterError("periods must be finite and >= 0 [s]")
+    periods = _check_periods(periods)
     sd = np.zeros_like(periods)
     omega = np.full_like(periods, np.inf)
     pos = periods > 0.0
@@ -740,8 +739,8 @@ def intensity_measures_hv(
         ``{"H": intensity_measures(horizontal, ...), "V": intensity_measures(vertical, ...),
         "v_over_h_pga": PGA_V / PGA_H [-]}`` (NaN if the horizontal is all zero).
     """
-    h = _as_record(horizontal)
-    v = _as_record(vertical)
+    h = _as_record(horizontal, "horizontal")
+    v = _as_record(vertical, "vertical")
     if h.shape != v.shape:
         raise ParameterError(
             f"horizontal and vertical must have the same length, got {h.size} and {v.size}"

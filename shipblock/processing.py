@@ -40,7 +40,8 @@ from types import MappingProxyType
 import numpy as np
 from obspy import Stream, Trace
 
-from shipblock.errors import ParameterError, ShipblockError
+from shipblock import checks
+from shipblock.errors import ParameterError, ParameterTypeError, ShipblockError
 from shipblock.intensity import displacement
 
 __all__ = [
@@ -150,7 +151,8 @@ def _float_copy(stream: Stream) -> Stream:
     if isinstance(stream, Trace):
         stream = Stream([stream])
     if not isinstance(stream, Stream):
-        raise TypeError(f"expected an obspy Stream, got {type(stream).__name__}")
+        raise ParameterTypeError(f"stream must be an obspy Stream (or Trace), got "
+                                 f"{type(stream).__name__}")
     out = stream.copy()
     for tr in out:
         tr.data = np.asarray(tr.data, dtype=np.float64)
@@ -224,6 +226,9 @@ def apply_chain(stream: Stream, chain: Iterable[Mapping]) -> Stream:
         unknown, missing or invalid parameter. The message names the step and parameter.
     """
     out = _float_copy(stream)
+    if isinstance(chain, Mapping | str | bytes) or not isinstance(chain, Iterable):
+        raise ProcessingError("<chain>", f"chain must be a list of tables {{step = ...}}, got "
+                                         f"{type(chain).__name__} {chain!r}")
     for k, entry in enumerate(chain):
         if not isinstance(entry, Mapping):
             raise ProcessingError("<chain>", f"entry {k} is not a table/mapping: {entry!r}")
@@ -290,7 +295,8 @@ def chain_from_provenance(trace: Trace) -> list[dict]:
 # --------------------------------------------------------------------------------------------
 # parameter validation helpers
 # --------------------------------------------------------------------------------------------
-def _real(name, param, value, *, positive=False, nonnegative=False) -> float:
+def _real(name, param, value, *, positive=False, nonnegative=False, minimum=None,
+          maximum=None) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
         raise ProcessingError(name, f"must be a number, got {value!r}", param)
     value = float(value)
@@ -300,6 +306,10 @@ def _real(name, param, value, *, positive=False, nonnegative=False) -> float:
         raise ProcessingError(name, f"must be > 0, got {value!r}", param)
     if nonnegative and value < 0.0:
         raise ProcessingError(name, f"must be >= 0, got {value!r}", param)
+    if minimum is not None and value < minimum:
+        raise ProcessingError(name, f"must be >= {minimum:g}, got {value!r}", param)
+    if maximum is not None and value > maximum:
+        raise ProcessingError(name, f"must be <= {maximum:g}, got {value!r}", param)
     return value
 
 
@@ -318,7 +328,7 @@ def _boolean(name, param, value) -> bool:
 
 
 def _choice(name, param, value, choices) -> str:
-    if value not in choices:
+    if not isinstance(value, str) or value not in choices:
         raise ProcessingError(name, f"must be one of {sorted(choices)}, got {value!r}", param)
     return value
 
@@ -575,7 +585,9 @@ def polynomial_baseline(acc: np.ndarray, dt: float, order: int = 6) -> np.ndarra
     numpy.ndarray
         :math:`P''(t_i)` [m/s^2], shape ``(n,)``.
     """
-    acc = np.asarray(acc, dtype=np.float64)
+    acc = checks.acceleration(acc, "acc")
+    dt = checks.time_step(dt, "dt")
+    order = checks.whole(order, "order", low=2, high=acc.size - 1)
     n = acc.size
     duration = (n - 1) * dt
     tau = np.arange(n) / (n - 1)
@@ -650,7 +662,8 @@ def resample(stream, *, sampling_rate, method="fft"):
     obspy.Stream
         Resampled copy.
     """
-    fs = _real("resample", "sampling_rate", sampling_rate, positive=True)
+    fs = _real("resample", "sampling_rate", sampling_rate, positive=True,
+               minimum=1.0 / checks.MAX_TIME_STEP, maximum=1.0 / checks.MIN_TIME_STEP)
     how = _choice("resample", "method", method, _RESAMPLE_METHODS)
     for tr in stream:
         if tr.stats.sampling_rate == fs:
@@ -690,8 +703,9 @@ def trim(stream, *, start=0.0, end=None):
     obspy.Stream
         Trimmed copy.
     """
-    t_start = _real("trim", "start", start, nonnegative=True)
-    t_end = None if end is None else _real("trim", "end", end, positive=True)
+    t_start = _real("trim", "start", start, nonnegative=True, maximum=checks.MAX_DURATION)
+    t_end = (None if end is None
+             else _real("trim", "end", end, positive=True, maximum=checks.MAX_DURATION))
     if t_end is not None and t_end <= t_start:
         raise ProcessingError("trim", f"must be greater than start={t_start}, got {t_end}", "end")
     if len(stream) == 0:
@@ -732,8 +746,8 @@ def pad(stream, *, before=0.0, after=0.0):
     .. [1] Boore, D. M. (2005). On pads and filters: processing strong-motion data.
        *Bull. Seismol. Soc. Am.* 95(2), 745-750.
     """
-    t_before = _real("pad", "before", before, nonnegative=True)
-    t_after = _real("pad", "after", after, nonnegative=True)
+    t_before = _real("pad", "before", before, nonnegative=True, maximum=checks.MAX_PADDING)
+    t_after = _real("pad", "after", after, nonnegative=True, maximum=checks.MAX_PADDING)
     for tr in stream:
         dt = tr.stats.delta
         n0 = int(round(t_before / dt))

@@ -26,8 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from shipblock import intensity
-from shipblock.errors import ParameterError, RecordError
+from shipblock import checks, intensity
+from shipblock.errors import ParameterError, ParameterTypeError, RecordError
+from shipblock.units import STANDARD_GRAVITY
 
 __all__ = [
     "MEASURES",
@@ -90,37 +91,32 @@ class ScaledRecord:
 
 
 def _check_record(acc, label: str) -> np.ndarray:
-    arr = np.asarray(acc, dtype=np.float64)
-    if arr.ndim != 1 or arr.size < 2:
-        raise RecordError(
-            label, f"must be a 1-D array of at least 2 samples, got shape {arr.shape}"
-        )
-    if not np.all(np.isfinite(arr)):
-        raise RecordError(label, "contains NaN or infinite values")
-    return arr
+    """A record as a 1-D float array of at least 2 samples, finite and within 100 g."""
+    return checks.acceleration(acc, label)
 
 
-def _check_measure(measure: str, period, damping):
+def _check_measure(measure, period, damping, names=("measure", "period")):
+    if not isinstance(measure, str):
+        raise ParameterTypeError(f"{names[0]} must be a string, one of {', '.join(MEASURES)}; "
+                                 f"got {type(measure).__name__} {measure!r}")
     if measure not in MEASURES:
-        raise ParameterError(f"unknown scaling measure {measure!r}; known: {', '.join(MEASURES)}")
+        raise ParameterError(f"unknown scaling measure {measure!r} ({names[0]}); known: "
+                             f"{', '.join(MEASURES)}")
     if measure == "sa":
         if period is None:
-            raise ParameterError("measure 'sa' needs a period [s]")
-        period = float(period)
-        if not np.isfinite(period) or period <= 0.0:
-            raise ParameterError(
-                f"period must be > 0 [s] for measure 'sa', got {period} (use measure 'pga' "
-                "for the zero-period limit)"
-            )
-        damping = float(damping)
-        if not (0.0 <= damping < 1.0):
-            raise ParameterError(f"damping must be in [0, 1), got {damping}")
+            raise ParameterError(f"measure 'sa' needs a period [s] ({names[1]})")
+        period = checks.real(period, names[1], low=checks.MIN_PERIOD, high=checks.MAX_PERIOD,
+                             units="s")
+        damping = checks.real(damping, "damping", low=0.0, high=1.0, high_open=True)
     elif period is not None:
-        raise ParameterError(f"period applies only to measure 'sa', not {measure!r}")
+        raise ParameterError(f"{names[1]}: period applies only to measure 'sa', not {measure!r}")
     return period, damping
 
 
 def _check_target(target, label="target") -> float:
+    if not checks.is_real(target):
+        raise ParameterTypeError(f"{label} must be a positive finite number, got "
+                                 f"{type(target).__name__} {target!r}")
     target = float(target)
     if not np.isfinite(target) or target <= 0.0:
         raise ParameterError(f"{label} must be a positive finite value, got {target}")
@@ -128,10 +124,23 @@ def _check_target(target, label="target") -> float:
 
 
 def _check_factor(factor, label="factor") -> float:
-    factor = float(factor)
-    if not np.isfinite(factor):
-        raise ParameterError(f"{label} must be finite, got {factor}")
-    return factor
+    return checks.real(factor, label)
+
+
+def _check_scaled_peak(acc: np.ndarray, factor: float, name: str, value) -> None:
+    """Refuse a scale factor that takes ``acc`` above :data:`shipblock.checks.MAX_ACCELERATION`."""
+    peak = abs(factor) * float(np.abs(acc).max())
+    if not peak <= checks.MAX_ACCELERATION:
+        raise ParameterError(
+            f"{name} = {value!r} needs a scale factor of {factor:.6g}, which takes the peak "
+            f"acceleration to {peak:.6g} m/s^2 ({peak / STANDARD_GRAVITY:.6g} g), above the "
+            f"plausibility limit {checks.MAX_ACCELERATION:g} m/s^2 (100 g)")
+
+
+def _check_flag(value, name: str) -> bool:
+    if not isinstance(value, bool | np.bool_):
+        raise ParameterTypeError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
 
 
 def measure_value(acc, dt, measure="pga", period=None, damping=intensity.DEFAULT_DAMPING) -> float:
@@ -213,7 +222,7 @@ def amplitude_factor(
     shipblock.errors.RecordError
         If the record's measure is zero (no factor can reach a positive target).
     """
-    a = _check_record(acc, label)
+    a = _check_record(acc, "acc" if label == "<array>" else label)
     target = _check_target(target)
     value = measure_value(a, dt, measure, period, damping)
     if not value > 0.0:
@@ -236,7 +245,10 @@ def scale(acc, factor) -> np.ndarray:
     numpy.ndarray
         New array [m/s^2].
     """
-    return _check_factor(factor) * np.asarray(acc, dtype=np.float64)
+    a = _check_record(acc, "acc")
+    factor = _check_factor(factor)
+    _check_scaled_peak(a, factor, "factor", factor)
+    return factor * a
 
 
 def scale_record(
@@ -312,11 +324,13 @@ def scale_record(
     shipblock.errors.RecordError
         For an invalid record or one whose targeted measure is zero.
     """
-    h = _check_record(horizontal, "<horizontal>")
-    v = None if vertical is None else _check_record(vertical, "<vertical>")
+    h = _check_record(horizontal, "horizontal")
+    v = None if vertical is None else _check_record(vertical, "vertical")
+    reverse = _check_flag(reverse, "reverse")
+    reverse_vertical = _check_flag(reverse_vertical, "reverse_vertical")
     if v is not None and v.shape != h.shape:
         raise RecordError("<vertical>", f"has {v.size} samples but the horizontal has {h.size}")
-    if vertical_mode not in VERTICAL_MODES:
+    if not isinstance(vertical_mode, str) or vertical_mode not in VERTICAL_MODES:
         raise ParameterError(f"vertical_mode must be one of {VERTICAL_MODES}, got {vertical_mode!r}")
     independent_opts = (vertical_target, vertical_factor, vertical_measure, vertical_period)
     if vertical_mode != "independent" and any(x is not None for x in independent_opts):
@@ -337,6 +351,8 @@ def scale_record(
         if f_h <= 0.0:
             raise ParameterError(f"factor must be > 0 (use reverse=True to flip polarity), got {f_h}")
         h_measure = measure
+    _check_scaled_peak(h, f_h, "target" if target is not None else "factor",
+                       target if target is not None else factor)
     if reverse:
         f_h = -f_h
     h_out = f_h * h
@@ -375,12 +391,19 @@ def scale_record(
                 label="<vertical>",
             )
         else:
-            _check_measure(v_measure, v_period, damping)
+            _check_measure(v_measure, v_period, damping, ("vertical_measure", "vertical_period"))
             f_v = _check_factor(vertical_factor, "vertical_factor")
             if f_v <= 0.0:
                 raise ParameterError(
                     f"vertical_factor must be > 0 (use reverse_vertical=True), got {f_v}"
                 )
+    if vertical_mode == "independent":
+        _check_scaled_peak(v, f_v, "vertical_target" if vertical_target is not None
+                           else "vertical_factor",
+                           vertical_target if vertical_target is not None else vertical_factor)
+    elif vertical_mode == "same":
+        _check_scaled_peak(v, f_v, "target" if target is not None else "factor",
+                           target if target is not None else factor)
     if reverse_vertical and f_v != 0.0:
         f_v = -f_v
     v_out = f_v * v

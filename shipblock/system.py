@@ -13,7 +13,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from shipblock.errors import ParameterError
+from shipblock.checks import choice, real, whole
+from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.units import STANDARD_GRAVITY
 
 IMPACT_RULES = ("momentum", "paper")
@@ -34,6 +35,28 @@ P_E = 11  # coefficient of restitution theta_dot+/theta_dot- [-]
 P_RULE = 12  # impact rule: 0 momentum-consistent, 1 paper (scale theta_dot only)
 P_G = 13  # gravity [m/s^2]
 N_PARAMS = 14
+
+#: Accepted range of every numeric field: name -> (lowest, highest, units), bounds included.
+#: Outside them a value is a typing or unit mistake, not a ship on keel blocks. The ranges are
+#: far wider than any dock (a 1e-9 kg "ship" stands for a block alone, friction up to 100 locks
+#: an interface) and narrow enough that every derived quantity stays a finite float.
+FIELD_LIMITS: dict[str, tuple[float | None, float | None, str]] = {
+    "ship_mass": (1e-9, 1e10, "kg"),
+    "block_mass": (1e-6, 1e8, "kg"),
+    "n_blocks": (1, 100_000, ""),
+    "half_width": (1e-4, 100.0, "m"),
+    "half_height": (1e-4, 100.0, "m"),
+    "mu_s_ground": (0.0, 100.0, ""),
+    "mu_k_ground": (0.0, 100.0, ""),
+    "mu_s_ship": (0.0, 100.0, ""),
+    "mu_k_ship": (0.0, 100.0, ""),
+    "restitution": (0.0, 1.0, ""),
+    "block_inertia": (0.0, None, "kg m^2"),  # and MIN_INERTIA_RATIO .. 1 times m (B^2 + H^2)
+    "g": (0.1, 100.0, "m/s^2"),
+}
+
+#: Smallest ratio I / (m R^2) of a block_inertia given explicitly [-] (1/3 for a uniform block).
+MIN_INERTIA_RATIO = 1e-6
 
 
 def system_restitution(mass_ratio: float, alpha: float, inertia_ratio: float = 1.0 / 3.0) -> float:
@@ -70,6 +93,10 @@ def system_restitution(mass_ratio: float, alpha: float, inertia_ratio: float = 1
     .. [1] Housner, G. W. (1963). The behavior of inverted pendulum structures during
        earthquakes. Bull. Seismol. Soc. Am. 53(2), 403-417.
     """
+    mass_ratio = real(mass_ratio, "mass_ratio", low=0.0)
+    alpha = real(alpha, "alpha", low=0.0, high=math.pi / 2, low_open=True, high_open=True,
+                 units="rad")
+    inertia_ratio = real(inertia_ratio, "inertia_ratio", low=0.0, high=1.0, low_open=True)
     # In units of M R^2: nI = kappa*Mn, (nm + 4M) = Mn + 4.
     num = inertia_ratio * mass_ratio + (mass_ratio + 4.0) * math.cos(2.0 * alpha)
     den = inertia_ratio * mass_ratio + (mass_ratio + 4.0)
@@ -110,10 +137,14 @@ class ShipBlockSystem:
 
     Raises
     ------
-    ValueError
-        For a non-positive mass or size, negative friction, a kinetic coefficient above the
-        static one, restitution outside [0, 1] or an unknown impact rule; the message names the
-        field.
+    ParameterTypeError
+        For a field of the wrong type (a string or None for a number, a bool...).
+    ParameterError
+        For a value outside its range in :data:`FIELD_LIMITS` (non-finite, a non-positive mass
+        or size, negative friction...), a kinetic coefficient above the static one, a
+        ``block_inertia`` outside :data:`MIN_INERTIA_RATIO` .. 1 times :math:`m(B^2+H^2)` or
+        an unknown impact rule. Both are
+        :class:`ValueError`; the message names the field and what it expects.
     """
 
     ship_mass: float
@@ -131,21 +162,16 @@ class ShipBlockSystem:
     g: float = STANDARD_GRAVITY
 
     def __post_init__(self):
-        def positive(name):
+        for name, (low, high, units) in FIELD_LIMITS.items():
             value = getattr(self, name)
-            if not (isinstance(value, int | float | np.floating | np.integer)) or not (
-                math.isfinite(value) and value > 0
-            ):
-                raise ParameterError(f"{name} must be a finite number > 0, got {value!r}")
-
-        for name in ("ship_mass", "block_mass", "half_width", "half_height", "g"):
-            positive(name)
-        if int(self.n_blocks) != self.n_blocks or self.n_blocks < 1:
-            raise ParameterError(f"n_blocks must be a whole number >= 1, got {self.n_blocks!r}")
-        for name in ("mu_s_ground", "mu_k_ground", "mu_s_ship", "mu_k_ship"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0):
-                raise ParameterError(f"{name} must be a finite number >= 0, got {value!r}")
+            if value is None and name in ("restitution", "block_inertia"):
+                continue
+            if name == "n_blocks":
+                # a whole float (3.0, as TOML or a sweep may give it) is kept as the int 3
+                object.__setattr__(self, name, whole(value, name, low=low, high=high))
+            else:
+                real(value, name, low=low, high=high, units=units,
+                     low_open=name == "block_inertia")
         for iface in ("ground", "ship"):
             mus, muk = getattr(self, f"mu_s_{iface}"), getattr(self, f"mu_k_{iface}")
             if muk > mus:
@@ -153,14 +179,17 @@ class ShipBlockSystem:
                     f"mu_k_{iface} ({muk}) must not exceed mu_s_{iface} ({mus}): kinetic friction "
                     "above static friction is not physical"
                 )
-        if self.restitution is not None and not (0.0 <= self.restitution <= 1.0):
-            raise ParameterError(f"restitution must lie in [0, 1], got {self.restitution!r}")
-        if self.impact_rule not in IMPACT_RULES:
-            raise ParameterError(f"impact_rule must be one of {IMPACT_RULES}, got {self.impact_rule!r}")
-        if self.block_inertia is not None and not (
-            math.isfinite(self.block_inertia) and self.block_inertia > 0
-        ):
-            raise ParameterError(f"block_inertia must be a finite number > 0, got {self.block_inertia!r}")
+        choice(self.impact_rule, "impact_rule", IMPACT_RULES)
+        if self.block_inertia is not None:
+            # every point of a block lies within R of its centroid: I <= m R^2; far below
+            # MIN_INERTIA_RATIO m R^2 the block is a point mass and the ratio underflows
+            most = self.block_mass * (self.half_width**2 + self.half_height**2)
+            if not MIN_INERTIA_RATIO * most <= self.block_inertia <= most:
+                raise ParameterError(
+                    f"block_inertia must lie between {MIN_INERTIA_RATIO:g} and 1 times "
+                    f"block_mass * (half_width^2 + half_height^2) = {most:g} kg m^2 (all the "
+                    f"mass at the corners), got {self.block_inertia!r}"
+                )
 
     # Derived quantities ------------------------------------------------------------------
     @property
@@ -258,21 +287,25 @@ class ShipBlockSystem:
             raise ParameterError(f"{source}: unknown system parameter(s) {unknown}; known: {sorted(known)}")
         try:
             return cls(**values)
-        except TypeError as exc:
-            raise ParameterError(f"{source}: {exc}") from None
-        except ValueError as exc:
-            raise ParameterError(f"{source}: {exc}") from None
+        except ParameterError as exc:  # also a ParameterTypeError: keep the type
+            raise type(exc)(f"{source}: {exc}") from None
+        except TypeError as exc:  # a missing field
+            raise ParameterTypeError(f"{source}: {exc}") from None
 
     @classmethod
     def from_toml(cls, path) -> ShipBlockSystem:
         """Read a system from a TOML file with a ``[system]`` table (SI units)."""
         import tomllib
 
-        with open(path, "rb") as fh:
-            try:
+        try:
+            with open(path, "rb") as fh:
                 data = tomllib.load(fh)
-            except tomllib.TOMLDecodeError as exc:
-                raise ParameterError(f"{path}: not valid TOML: {exc}") from None
+        except OSError as exc:
+            raise ParameterError(f"{path}: cannot read the system file ({exc})") from None
+        except UnicodeDecodeError:
+            raise ParameterError(f"{path}: not a text (UTF-8) TOML file") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise ParameterError(f"{path}: not valid TOML: {exc}") from None
         return cls.from_mapping(data, source=str(path))
 
     def replace(self, **changes) -> ShipBlockSystem:

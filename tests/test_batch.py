@@ -323,3 +323,17 @@ def test_run_batch_results_do_not_depend_on_the_chunk_size(tmp_path):
         for name in results[0]:
             np.testing.assert_array_equal(other[name], results[0][name])
     assert list(results[0]["run_error"]) == [""] * 12  # the bad record has no run errors
+
+
+def test_record_scaled_above_100_g_is_left_out_not_run():
+    """Sa at a long period can need more than 100 g of ground acceleration: the record is left
+    out with the reason (the solver would refuse the run and stop the batch)."""
+    design = IntensityDesign("ida", measure="sa", period=20.0, levels=(0.01 * G, 10.0 * G))
+    rec = prepare_record("syn0", _loader(0), [], design.validate())
+    assert rec.horizontal is None and rec.error is not None
+    assert "above the plausibility limit" in rec.error and "100 g" in rec.error
+    assert "98.066" in rec.error  # names the level (10 g) it cannot be scaled to
+    ok = prepare_record("syn0", _loader(0), [], IntensityDesign(
+        "ida", measure="sa", period=20.0, levels=(0.01 * G,)).validate())
+    assert ok.error is None
+    assert ok.factor_h[0] * np.abs(ok.horizontal).max() < 100 * G

@@ -344,6 +344,154 @@ def test_missing_section_and_bad_toml(tmp_path):
         load_pipeline(path)
 
 
+LEVELS = "levels_g = [0.2, 0.4, 0.5, 0.6, 0.8]"
+
+
+@pytest.mark.parametrize(
+    ("edit", "key", "needle"),
+    [
+        (lambda t: t.replace(LEVELS, "levels_g = [1e6]"), "design.levels_g", "1e+06 g"),
+        (lambda t: t.replace(LEVELS, "levels_g = [1e300]"), "design.levels_g", "0.001 .. 10 g"),
+        (lambda t: t.replace(LEVELS, "levels_g = [1e-300]"), "design.levels_g", "0.001 .. 10 g"),
+        (lambda t: t.replace(LEVELS, 'levels = [2.0, 1e300]\nunits = "m/s^2"'), "design.levels",
+         "levels[1]"),
+        (lambda t: t.replace(LEVELS, 'measure = "pgv"\nlevels = [50.0]\nunits = "m/s"'),
+         "design.levels", "10 m/s"),
+        (lambda t: t.replace(LEVELS, LEVELS + '\nvertical = "independent"\n'
+                                              "vertical_levels_g = [1e6, 1, 1, 1, 1]"),
+         "design.vertical_levels_g", "vertical_levels_g[0]"),
+        (lambda t: t.replace('type = "ida"', 'type = "ida"\nmeasure = "sa"\nperiod = 1e300'),
+         "design.period", "[0.0001, 100]"),
+        (lambda t: t.replace("bootstrap = 20", "bootstrap = 1000000000000"), "fit.bootstrap",
+         "[0, 10000]"),
+        (lambda t: t.replace("bootstrap = 20", "bootstrap = 1e12"), "fit.bootstrap",
+         "an integer"),
+        (lambda t: t.replace('horizontal = "H1"', "azimuth = nan"), "records.azimuth", "nan"),
+        (lambda t: t.replace('horizontal = "H1"', "azimuth = inf"), "records.azimuth", "inf"),
+        (lambda t: t.replace("seed = 3", "seed = -1"), "fit.seed", "got -1"),
+        (lambda t: t.replace("seed = 3", "seed = 1180591620717411303424"), "fit.seed",
+         "9223372036854775807"),
+        (lambda t: t.replace('output = "out/result.nc"', 'output = ""'), "output", "got ''"),
+        (lambda t: t.replace('output = "out/result.nc"', 'output = "out/"'), "output", "'out/'"),
+        (lambda t: t.replace('output = "out/result.nc"', 'output = "records"'), "output",
+         "is a folder"),
+        (lambda t: t.replace("[execution]", "[solver]\nrtol = 1e-300\n[execution]"),
+         "solver.rtol", "1e-300"),
+        (lambda t: t.replace("[execution]", "[solver]\nzeno_omega = inf\n[execution]"),
+         "solver.zeno_omega", "inf"),
+        (lambda t: t.replace("chunk_size = 4", "chunk_size = 1000000000000000"),
+         "execution.chunk_size", "[1, 1000000]"),
+        (lambda t: t.replace("[execution]", '[execution]\nscheduler = ""'),
+         "execution.scheduler", "empty"),
+        (lambda t: t.replace('ids = "all"', 'ids = ["syn/S0", "syn/S1", "syn/S0"]'),
+         "records.ids", "repeats syn/S0"),
+        (lambda t: t.replace("ship_mass = 5.0e6", "ship_mass = inf"), "system.ship_mass", "inf"),
+        (lambda t: t.replace("half_width = 0.3", "slenderness = 1e300"), "system.slenderness",
+         "half_width"),
+        (lambda t: t.replace("[fit]", "[sweep]\nn_blocks = [150, 1e300]\n[fit]"),
+         "sweep.n_blocks", "n_blocks"),
+        (lambda t: t.replace("[fit]", "[sweep]\nmu_ground = [nan]\n[fit]"), "sweep.mu_ground",
+         "mu_s_ground"),
+        (lambda t: t.replace("[fit]", "[sweep]\nmu_ground = [" + ", ".join(
+            f"{0.2 + 1e-4 * i:.4f}" for i in range(1000)) + "]\nslenderness = [" + ", ".join(
+            f"{0.2 + 1e-4 * i:.4f}" for i in range(1000)) + "]\n[fit]"), "sweep",
+         "15,000,000 runs"),
+        (lambda t: t + '\n[histories]\nexceeding = ["ship_slip"]\nmax_runs = 0\n',
+         "histories.max_runs", "got 0"),
+    ],
+)
+def test_pipeline_values_of_issue_23_are_checked_when_loaded(tmp_path, edit, key, needle):
+    """Implausible values, ranges and sizes are refused when the file is loaded (before any
+    record is read or run is made), naming the key and what it expects."""
+    path = write_pipeline(tmp_path)
+    path.write_text(edit(path.read_text()))
+    with pytest.raises(PipelineError) as info:
+        load_pipeline(path)
+    assert info.value.key == key, str(info.value)
+    assert f"[{key}]" in str(info.value) and str(path) in str(info.value)
+    assert needle in str(info.value), str(info.value)
+
+
+def test_binary_pipeline_file_names_the_file(tmp_path):
+    path = tmp_path / "p.toml"
+    path.write_bytes(bytes(range(256)) * 4)
+    with pytest.raises(PipelineError, match="not UTF-8 text") as info:
+        load_pipeline(path)
+    assert str(path) in str(info.value)
+    path.write_bytes(b'schema_version = 1\x00\x01\x02 output = "x.nc"')
+    with pytest.raises(PipelineError, match="binary data") as info:
+        load_pipeline(path)
+    assert str(path) in str(info.value)
+
+
+def test_unknown_key_lists_the_known_keys(tmp_path):
+    path = write_pipeline(tmp_path)
+    path.write_text(path.read_text().replace("seed = 3", "seed = 3\nsede = 4"))
+    with pytest.raises(PipelineError, match="allowed keys: bootstrap, confidence, seed, "
+                                            "ida_method") as info:
+        load_pipeline(path)
+    assert info.value.key == "fit.sede"
+
+
+def test_run_pipeline_arguments_are_named(tmp_path):
+    from shipblock.errors import ParameterTypeError
+
+    path = write_pipeline(tmp_path)
+    for kwargs, name in (({"path": None}, "path"), ({"path": 3}, "path"),
+                         ({"path": path, "output": 3}, "output"),
+                         ({"path": path, "timings": []}, "timings"),
+                         ({"path": path, "scheduler": 8786}, "scheduler")):
+        with pytest.raises(ParameterTypeError, match=f"^{name} must be"):
+            run_pipeline(progress=False, **kwargs)
+    assert _no_partial(tmp_path) == []
+
+
+def _no_partial(folder: Path) -> list:
+    return sorted(p.name for p in folder.rglob("*.partial"))
+
+
+def test_study_with_every_record_left_out_fails_before_the_batch(tmp_path):
+    path = write_pipeline(tmp_path, ids='["syn/BAD"]', bad=True)
+    with pytest.raises(PipelineError, match="every record was left out") as info:
+        run_pipeline(path, progress=False)
+    assert info.value.key == "records.ids" and "syn/BAD" in str(info.value)
+    assert not (tmp_path / "out" / "result.nc").exists()
+    assert _no_partial(tmp_path) == []
+
+
+def test_bad_output_fails_before_the_batch(tmp_path, monkeypatch):
+    from shipblock.fragility import batch
+
+    monkeypatch.setattr(batch, "run_chunk", lambda *a, **k: pytest.fail("the batch ran"))
+    path = write_pipeline(tmp_path)
+    with pytest.raises(PipelineError, match="must name a NetCDF file") as info:
+        run_pipeline(path, output="", progress=False)
+    assert info.value.key == "output"
+    (tmp_path / "a_file").write_text("")
+    with pytest.raises(PipelineError, match="cannot create the folder"):
+        run_pipeline(path, output=tmp_path / "a_file" / "result.nc", progress=False)
+    assert _no_partial(tmp_path) == []
+
+
+def test_dask_scheduler_without_dask_says_which_extra_to_install(tmp_path, monkeypatch):
+    from shipblock.fragility import batch
+
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed fails
+    monkeypatch.setattr(batch, "run_chunk", lambda *a, **k: pytest.fail("the batch ran"))
+    path = write_pipeline(tmp_path)
+    path.write_text(path.read_text().replace("[execution]",
+                                             '[execution]\nscheduler = "tcp://127.0.0.1:1"'))
+    with pytest.raises(PipelineError) as info:
+        run_pipeline(path, progress=False)
+    assert info.value.key == "execution.scheduler"
+    assert 'pip install "shipblock[dask]"' in str(info.value)
+    assert "tcp://127.0.0.1:1" in str(info.value)
+    with pytest.raises(PipelineError, match=r"shipblock\[dask\]"):  # the argument too
+        run_pipeline(write_pipeline(tmp_path, name="q.toml"), scheduler="tcp://h:1",
+                     progress=False)
+    assert _no_partial(tmp_path) == []
+
+
 def test_shipped_pipelines_are_valid():
     root = Path(__file__).resolve().parent.parent / "pipelines"
     for name in ("demo", "napa_ida", "sensitivity"):
@@ -410,6 +558,108 @@ def test_resume_after_sigkill_gives_same_result(tmp_path, monkeypatch):
     assert len(calls) == 15 - done  # finished chunks were not recomputed
     assert_same_results(reference, resumed)
     assert not partial.exists()
+
+
+_SLOW_FITS = textwrap.dedent(
+    """
+    import sys, time
+    from shipblock.fragility import pipeline
+    pipeline.FIT_CHECKPOINT_INTERVAL = 0.0   # every fit written as soon as it is done
+    real = pipeline._fit_one
+    def slow(*args, **kwargs):
+        time.sleep(0.4)   # make fits slow enough to be killed among them
+        return real(*args, **kwargs)
+    pipeline._fit_one = slow
+    pipeline.run_pipeline(sys.argv[1], output=sys.argv[2], progress=False)
+    """
+)
+
+
+def _run_until(proc, condition, what):
+    """Wait until ``condition()`` holds, then SIGKILL ``proc``."""
+    try:
+        deadline = time.monotonic() + 180
+        while time.monotonic() < deadline:
+            if condition():
+                break
+            if proc.poll() is not None:
+                pytest.fail(f"the run ended before {what}")
+            time.sleep(0.02)
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == -signal.SIGKILL
+
+
+def test_resume_after_sigkill_during_the_fits_gives_same_result(tmp_path, monkeypatch):
+    """Fitted results are kept per (limit state, sweep point) like the chunks: a run killed
+    after the batch resumes without running the batch or the finished fits again, and gives
+    the uninterrupted run's dataset exactly."""
+    path = write_pipeline(tmp_path, sweep="[sweep]\nmu_ground = [0.3, 0.4, 0.5, 0.6]\n",
+                          chunk_size=64)  # 60 runs in one chunk; 2 limit states x 4 = 8 fits
+    reference = run_pipeline(path, output=tmp_path / "reference.nc", progress=False)
+
+    out = tmp_path / "killed.nc"
+    partial = tmp_path / "killed.nc.partial"
+    proc = subprocess.Popen([sys.executable, "-c", _SLOW_FITS, str(path), str(out)])
+    _run_until(proc, lambda: partial.is_dir() and len(list(partial.glob("fit-*.npz"))) >= 3,
+               "it could be killed among the fits")
+    assert not out.exists()
+    assert len(list(partial.glob("chunk-*.npz"))) == 1  # the batch was done
+    done = len(list(partial.glob("fit-*.npz")))  # one fit a file
+    assert 3 <= done < 8
+
+    from shipblock.fragility import batch
+    from shipblock.fragility import pipeline as pipeline_mod
+
+    monkeypatch.setattr(batch, "run_chunk", lambda *a, **k: pytest.fail("the batch ran again"))
+    calls = []
+    real = pipeline_mod._fit_one
+    monkeypatch.setattr(pipeline_mod, "_fit_one",
+                        lambda *a, **k: (calls.append(1), real(*a, **k))[1])
+    resumed = run_pipeline(path, output=out, progress=False)
+    assert len(calls) == 8 - done  # finished fits were not made again
+    assert_same_results(reference, resumed)
+    assert not partial.exists()
+
+
+_KILL_IN_WRITE = textwrap.dedent(
+    """
+    import os, signal, sys
+    import xarray as xr
+    real = xr.Dataset.to_netcdf
+    def killed(self, path, *args, **kwargs):
+        real(self, path, *args, **kwargs)      # the temporary file is written ...
+        os.kill(os.getpid(), signal.SIGKILL)   # ... and the run killed before the rename
+    xr.Dataset.to_netcdf = killed
+    from shipblock.fragility.pipeline import run_pipeline
+    run_pipeline(sys.argv[1], output=sys.argv[2], progress=False)
+    """
+)
+
+
+def test_next_run_removes_the_temporary_file_of_a_killed_final_write(tmp_path):
+    path = write_pipeline(tmp_path)
+    out = tmp_path / "res" / "result.nc"
+    out.parent.mkdir()
+    other = out.parent / ".other.nc.abcdefgh.tmp"  # another output's temporary file
+    lookalike = out.parent / ".result.nc.mine.tmp"  # not a name our writer makes
+    for p in (other, lookalike):
+        p.write_text("keep")
+    proc = subprocess.run([sys.executable, "-c", _KILL_IN_WRITE, str(path), str(out)])
+    assert proc.returncode == -signal.SIGKILL
+    assert not out.exists()
+    stale = [p for p in out.parent.glob(".result.nc.*.tmp") if p != lookalike]
+    assert len(stale) == 1 and stale[0].stat().st_size > 0
+
+    ds = run_pipeline(path, output=out, progress=False)
+    assert out.is_file() and ds.sizes["record"] == 3
+    assert not stale[0].exists()
+    assert other.read_text() == "keep" and lookalike.read_text() == "keep"
+    assert sorted(p.name for p in out.parent.iterdir()) == sorted(
+        [".other.nc.abcdefgh.tmp", ".result.nc.mine.tmp", "result.nc"])
 
 
 def test_partial_of_another_run_is_refused(tmp_path):

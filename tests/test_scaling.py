@@ -116,10 +116,19 @@ def test_vertical_unscaled_zero_and_absent(record):
     measure=st.sampled_from(sorted(MEASURES)),
 )
 def test_targets_property(target, measure):
-    """Any positive target of any measure is reached (homogeneity)."""
+    """Any positive target of any measure is reached (homogeneity), unless the scaled record
+    would exceed the plausibility limit of 100 g: then a ParameterError names the target."""
+    from shipblock.checks import MAX_ACCELERATION
+    from shipblock.errors import ParameterError
+
     t = np.arange(500) * DT
     h = np.sin(2 * np.pi * 2.0 * t) * np.exp(-t)
     period = 0.3 if measure == "sa" else None
+    factor = amplitude_factor(h, DT, target, measure=measure, period=period)
+    if factor * np.abs(h).max() > MAX_ACCELERATION:
+        with pytest.raises(ParameterError, match="target"):
+            scale_record(h, None, DT, target=target, measure=measure, period=period)
+        return
     out = scale_record(h, None, DT, target=target, measure=measure, period=period)
     assert out.achieved == pytest.approx(target, rel=1e-10)
 

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -118,3 +121,61 @@ def test_write_dataset_refuses_missing_metadata_and_keeps_old_file(tmp_path):
     with pytest.raises(StoreError):
         write_dataset(bad, path)
     assert path.read_bytes() == before
+
+
+def test_fit_group_is_kept_apart_from_the_chunks(tmp_path):
+    store = ChunkStore(tmp_path / "p", "abc").open()
+    store.write(0, [0, 1], {"peak_ship_slip": np.array([0.1, 0.2])})
+    fits = {"median": np.array([1.5, np.nan]), "n_fit_records": np.array([3, 0]),
+            "fit_method": np.array(["mle", ""]), "capacity": np.array([[1.0, np.inf], [2.0, 3.0]])}
+    store.write(0, [5, 7], fits, group="fit")
+    assert store.completed() == {0} and store.completed("fit") == {0}
+    assert sorted(p.name for p in (tmp_path / "p").glob("*.npz")) == ["chunk-000000.npz",
+                                                                      "fit-000000.npz"]
+    numbers, back = store.read(0, "fit")
+    np.testing.assert_array_equal(numbers, [5, 7])
+    for name, value in fits.items():
+        np.testing.assert_array_equal(back[name], value)
+        assert back[name].dtype.kind == value.dtype.kind
+    store.discard(0, "fit")
+    assert store.completed("fit") == set() and store.completed() == {0}
+    with pytest.raises(StoreError, match="unknown file group"):
+        store.completed("chunks")
+
+
+def test_stale_temporary_files_of_the_same_output_are_removed(tmp_path):
+    """Only names the writers themselves make (``.<name>.<8 random characters>.tmp``) for this
+    output are removed; other outputs' and look-alike files stay."""
+    from shipblock.fragility.store import remove_stale_temporaries
+
+    out = tmp_path / "r.nc"
+    ours = [tmp_path / ".r.nc.k2_9abcd.tmp", tmp_path / ".r.nc.zzzzzzzz.tmp"]
+    others = [tmp_path / ".r.nc.short.tmp", tmp_path / ".rr.nc.abcdefgh.tmp",
+              tmp_path / ".r.nc.abcdefgh.tmp.bak", tmp_path / "r.nc.abcdefgh.tmp",
+              tmp_path / ".r.nc.abc-efgh.tmp", tmp_path / "r.nc"]
+    for p in ours + others:
+        p.write_text("x")
+    assert sorted(remove_stale_temporaries(out)) == sorted(ours)
+    assert all(p.exists() for p in others) and not any(p.exists() for p in ours)
+    assert remove_stale_temporaries(tmp_path / "missing" / "r.nc") == []
+    # the names are those write_dataset uses: a real temporary name matches
+    from shipblock.fragility.store import _temporary
+
+    fd, name = _temporary(out)
+    os.close(fd)
+    assert remove_stale_temporaries(out) == [Path(name)]
+
+
+def test_chunk_store_open_removes_its_own_stale_temporary_files(tmp_path):
+    store = ChunkStore(tmp_path / "p", "abc").open()
+    d = tmp_path / "p"
+    ours = [d / ".chunk-000003.npz.abcdefgh.tmp", d / ".fit-000001.npz.a1b2c3d4.tmp",
+            d / ".manifest.json.abcdefgh.tmp"]
+    others = [d / ".chunk-000003.npz.xyz.tmp", d / ".notes.txt.abcdefgh.tmp"]
+    for p in ours + others:
+        p.write_bytes(b"half")
+    store.write(1, [4], {"peak_ship_slip": np.array([0.5])})
+    ChunkStore(d, "abc").open()
+    assert not any(p.exists() for p in ours)
+    assert all(p.exists() for p in others)
+    assert store.completed() == {1}

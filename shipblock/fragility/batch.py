@@ -157,7 +157,9 @@ def prepare_record(
     Returns
     -------
     PreparedRecord
-        With ``error`` set (and no data) if reading, processing or scaling failed.
+        With ``error`` set (and no data) if reading, processing or scaling failed (also if a
+        level needs a scaled record above :data:`shipblock.checks.MAX_ACCELERATION`, 100 g,
+        which :func:`~shipblock.scaling.scale_record` refuses).
     """
     from shipblock.processing import process_motion
     from shipblock.scaling import measure_value, scale_record

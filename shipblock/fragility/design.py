@@ -31,18 +31,20 @@ swept together (the width follows the height).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from shipblock.errors import ParameterError
+from shipblock.checks import MAX_PERIOD, MIN_PERIOD, choice, real, whole
+from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.intensity import DEFAULT_DAMPING
-from shipblock.system import ShipBlockSystem
+from shipblock.system import FIELD_LIMITS, ShipBlockSystem
+from shipblock.units import STANDARD_GRAVITY
 
 __all__ = [
     "DESIGN_TYPES",
+    "IM_LEVEL_RANGE",
     "IM_MEASURES",
     "SWEEP_PARAMETERS",
     "VERTICAL_MODES",
@@ -51,6 +53,7 @@ __all__ = [
     "SYSTEM_FIELDS",
     "apply_parameters",
     "as_sweep",
+    "check_levels",
 ]
 
 #: Analysis types: incremental dynamic analysis, multiple-stripe analysis, cloud analysis.
@@ -88,6 +91,15 @@ SWEEP_PARAMETERS: Mapping[str, tuple[str, str]] = {
     "mu_ship": ("1", "static friction coefficient ship-blocks (kinetic/static ratio kept)"),
 }
 
+#: Accepted range of IM levels per measure [SI units of the measure]: PGA and Sa 0.001 g to
+#: 10 g, PGV 1 mm/s to 10 m/s. Outside it a level is a unit mistake (1e6 g) or no motion at
+#: all, and scaling a record to it would give an implausible ground motion.
+IM_LEVEL_RANGE: Mapping[str, tuple[float, float]] = {
+    "pga": (1e-3 * STANDARD_GRAVITY, 10.0 * STANDARD_GRAVITY),
+    "pgv": (1e-3, 10.0),
+    "sa": (1e-3 * STANDARD_GRAVITY, 10.0 * STANDARD_GRAVITY),
+}
+
 _CONVENIENCES = ("slenderness", "mass_ratio", "mu_ground", "mu_ship")
 _CONFLICTS = {
     "slenderness": ("half_width",),
@@ -95,6 +107,44 @@ _CONFLICTS = {
     "mu_ground": ("mu_s_ground", "mu_k_ground"),
     "mu_ship": ("mu_s_ship", "mu_k_ship"),
 }
+
+
+def check_levels(values, name: str, measure: str) -> np.ndarray:
+    """IM levels as a float array, each a number within :data:`IM_LEVEL_RANGE` of ``measure``.
+
+    Parameters
+    ----------
+    values : sequence of float
+        Levels in SI units of the measure.
+    name : str
+        The argument's name, for the message.
+    measure : {"pga", "pgv", "sa"}
+        The intensity measure.
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Raises
+    ------
+    ParameterTypeError, ParameterError
+        Naming the first level (``name[i]``) that is not a number within range.
+    """
+    if isinstance(values, str | bytes) or not isinstance(values, Sequence | np.ndarray):
+        raise ParameterTypeError(f"{name} must be a sequence of IM levels, got "
+                                 f"{type(values).__name__}")
+    low, high = IM_LEVEL_RANGE[measure]
+    units = IM_MEASURES[measure][0]
+    out = []
+    for i, value in enumerate(values):
+        x = real(value, f"{name}[{i}]", units=units)
+        if not low <= x <= high:
+            in_g = (f" ({low / STANDARD_GRAVITY:g} g .. {high / STANDARD_GRAVITY:g} g)"
+                    if units == "m/s^2" else "")
+            raise ParameterError(f"{name}[{i}] = {x:g} {units} is outside the accepted range "
+                                 f"{low:g} .. {high:g} {units}{in_g} of {measure.upper()} levels")
+        out.append(x)
+    return np.array(out, dtype=float)
 
 
 def apply_parameters(system: ShipBlockSystem, values: Mapping[str, object]) -> ShipBlockSystem:
@@ -150,11 +200,8 @@ def apply_parameters(system: ShipBlockSystem, values: Mapping[str, object]) -> S
 
 
 def _whole(value, name):
-    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
-        raise ParameterError(f"{name} must be a whole number, got {value!r}")
-    if int(value) != value:
-        raise ParameterError(f"{name} must be a whole number, got {value!r}")
-    return int(value)
+    low, high, _ = FIELD_LIMITS[name]
+    return whole(value, name, low=low, high=high)
 
 
 @dataclass(frozen=True)
@@ -174,9 +221,9 @@ class IntensityDesign:
         Scaling intensity measure of the horizontal component.
     levels : tuple of float
         Target IM levels in SI units of the measure ([m/s^2] for PGA and Sa, [m/s] for PGV),
-        positive and strictly increasing; empty for a cloud.
+        strictly increasing, each within :data:`IM_LEVEL_RANGE`; empty for a cloud.
     period : float or None
-        Oscillator period for ``measure="sa"`` [s].
+        Oscillator period for ``measure="sa"`` [s], in [0.0001, 100].
     damping : float
         Fraction of critical damping for ``measure="sa"`` [-].
     vertical : {"same", "independent", "unscaled", "zero"}
@@ -228,42 +275,39 @@ class IntensityDesign:
 
         Raises
         ------
-        ValueError
-            Naming the offending field.
+        ParameterError
+            Naming the offending field (its message starts with the field's name): an unknown
+            type, measure or vertical mode, a period or damping out of range, a level that is
+            not a number within :data:`IM_LEVEL_RANGE`, levels not strictly increasing.
         """
-        if self.kind not in DESIGN_TYPES:
-            raise ParameterError(f"type must be one of {DESIGN_TYPES}, got {self.kind!r}")
-        if self.measure not in IM_MEASURES:
-            raise ParameterError(f"measure must be one of {tuple(IM_MEASURES)}, got {self.measure!r}")
+        choice(self.kind, "type", DESIGN_TYPES)
+        choice(self.measure, "measure", tuple(IM_MEASURES))
         if self.measure == "sa":
-            if self.period is None or not (math.isfinite(self.period) and self.period > 0):
-                raise ParameterError(f"period [s] must be > 0 for measure 'sa', got {self.period!r}")
+            if self.period is None:
+                raise ParameterError("period [s] is required for measure 'sa'")
+            real(self.period, "period", low=MIN_PERIOD, high=MAX_PERIOD, units="s")
         elif self.period is not None:
             raise ParameterError(f"period applies only to measure 'sa', not {self.measure!r}")
-        if not (0.0 <= self.damping < 1.0):
-            raise ParameterError(f"damping must lie in [0, 1), got {self.damping!r}")
-        if self.vertical not in VERTICAL_MODES:
-            raise ParameterError(f"vertical must be one of {VERTICAL_MODES}, got {self.vertical!r}")
-        levels = np.asarray(self.levels, dtype=float)
+        real(self.damping, "damping", low=0.0, high=1.0, high_open=True)
+        choice(self.vertical, "vertical", VERTICAL_MODES)
+        levels = check_levels(self.levels, "levels", self.measure)
         if self.scaled:
             if levels.size == 0:
-                raise ParameterError(f"a {self.kind!r} design needs at least one IM level")
-            if not (np.all(np.isfinite(levels)) and np.all(levels > 0)):
-                raise ParameterError("levels must be finite and positive")
+                raise ParameterError(f"levels: a {self.kind!r} design needs at least one IM level")
             if np.any(np.diff(levels) <= 0):
                 raise ParameterError("levels must be strictly increasing")
         elif levels.size:
-            raise ParameterError("a 'cloud' design uses the records as recorded; remove the levels")
+            raise ParameterError("levels: a 'cloud' design uses the records as recorded; remove "
+                                 "the levels")
         if self.vertical == "independent":
             if not self.scaled:
                 raise ParameterError("vertical 'independent' needs scaled levels (not a cloud)")
-            v = np.asarray(self.vertical_levels if self.vertical_levels is not None else [])
+            v = check_levels(self.vertical_levels if self.vertical_levels is not None else (),
+                           "vertical_levels", self.measure)
             if v.shape != levels.shape:
                 raise ParameterError(
                     f"vertical_levels must give one vertical target per level ({levels.size})"
                 )
-            if not (np.all(np.isfinite(v)) and np.all(v > 0)):
-                raise ParameterError("vertical_levels must be finite and positive")
         elif self.vertical_levels is not None:
             raise ParameterError("vertical_levels apply only to vertical = 'independent'")
         return self

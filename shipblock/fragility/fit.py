@@ -50,7 +50,8 @@ from typing import Any, NamedTuple
 import numpy as np
 from scipy import optimize, special, stats
 
-from shipblock.errors import ParameterError, ShipblockError
+from shipblock import checks
+from shipblock.errors import ParameterError, ParameterTypeError, ShipblockError
 
 __all__ = [
     "BootstrapResult",
@@ -158,6 +159,17 @@ class FragilityFit:
         return lognormal_fragility(x, self.median, self.beta)
 
 
+def _reals(values, name: str, kinds: str = "iuf") -> np.ndarray:
+    """An argument as a float array, or a ParameterTypeError naming it."""
+    return checks.as_real_array(values, name, "an array of numbers", kinds)
+
+
+def _method(value, name: str, choices: tuple[str, ...]) -> str:
+    if not isinstance(value, str):
+        raise ParameterTypeError(f"{name} must be one of {choices}, got {type(value).__name__}")
+    return value
+
+
 def lognormal_fragility(x, median, beta):
     r"""Lognormal fragility function, eq. :eq:`lognormal-fragility`.
 
@@ -175,7 +187,23 @@ def lognormal_fragility(x, median, beta):
     numpy.ndarray
         :math:`\Phi(\ln(x/\theta)/\beta)` [-], broadcast shape of the inputs.
     """
-    x = np.asarray(x, dtype=float)
+    x = _reals(x, "x")
+    median, beta = _reals(median, "median"), _reals(beta, "beta")
+    if not np.all(x >= 0.0):
+        raise ParameterError("x must be non-negative [IM units] (no NaN)")
+    for name, value in (("median", median), ("beta", beta)):
+        if not np.all(np.isfinite(value) & (value > 0.0)):
+            raise ParameterError(f"{name} must be finite and positive, got {value!r}")
+    try:
+        np.broadcast_shapes(x.shape, median.shape, beta.shape)
+    except ValueError:
+        raise ParameterError(f"x, median and beta must broadcast together, got shapes {x.shape}, "
+                             f"{median.shape}, {beta.shape}") from None
+    return _lognormal(x, median, beta)
+
+
+def _lognormal(x, median, beta):
+    """:func:`lognormal_fragility` without the argument checks (for arrays made here)."""
     with np.errstate(divide="ignore"):
         return special.ndtr((np.log(x) - np.log(median)) / beta)
 
@@ -313,9 +341,7 @@ def fit_mle(im_levels, n_exceed, n_total, *, fixed_beta=None) -> FragilityFit:
         return nll, dz, d2z
 
     if fixed_beta is not None:
-        beta = float(fixed_beta)
-        if not (np.isfinite(beta) and beta > 0):
-            raise ParameterError(f"fixed_beta must be a positive finite number, got {fixed_beta!r}")
+        beta = checks.real(fixed_beta, "fixed_beta", low=0.0, low_open=True)
         if not np.any(k > 0):
             raise FragilityFitError(
                 "no exceedances at any IM level: the median is only bounded below by the "
@@ -435,9 +461,9 @@ def _newton_minimize(parts, x0, *, scale, max_iter=100):
 
 
 def _validate_counts(im_levels, n_exceed, n_total):
-    x = np.asarray(im_levels, dtype=float)
-    k = np.asarray(n_exceed)
-    n = np.asarray(n_total)
+    x = _reals(im_levels, "im_levels")
+    k = _reals(n_exceed, "n_exceed")
+    n = _reals(n_total, "n_total")
     if x.ndim != 1 or k.shape != x.shape or n.shape != x.shape:
         raise ParameterError(
             "im_levels, n_exceed and n_total must be 1-D arrays of the same length, got shapes "
@@ -480,13 +506,13 @@ def fit_msa(exceeded, im_levels, valid=None, *, fixed_beta=None) -> FragilityFit
     -----
     The record axis comes first so that :func:`bootstrap` can resample records (rows).
     """
-    e = np.asarray(exceeded, dtype=bool)
-    x = np.asarray(im_levels, dtype=float)
+    e = _reals(exceeded, "exceeded", "biuf").astype(bool)
+    x = _reals(im_levels, "im_levels")
     if e.ndim != 2 or e.shape[1] != x.size:
         raise ParameterError(
             f"exceeded must have shape (n_records, {x.size}) to match im_levels, got {e.shape}"
         )
-    w = np.ones_like(e) if valid is None else np.asarray(valid, dtype=bool)
+    w = np.ones_like(e) if valid is None else _reals(valid, "valid", "biuf").astype(bool)
     if w.shape != e.shape:
         raise ParameterError(f"valid must have the shape of exceeded {e.shape}, got {w.shape}")
     return fit_mle(x, np.sum(e & w, axis=0), np.sum(w, axis=0), fixed_beta=fixed_beta)
@@ -552,15 +578,16 @@ def ida_capacities(exceeded, im_levels, valid=None) -> IDACapacities:
     .. [1] Vamvatsikos, D., & Cornell, C. A. (2002). Incremental dynamic analysis. *Earthquake
        Engineering & Structural Dynamics*, 31(3), 491-514.
     """
-    e = np.asarray(exceeded, dtype=bool)
-    x = np.asarray(im_levels, dtype=float)
+    e = _reals(exceeded, "exceeded", "biuf").astype(bool)
+    x = _reals(im_levels, "im_levels")
     if e.ndim != 2 or e.shape[1] != x.size:
         raise ParameterError(
             f"exceeded must have shape (n_records, {x.size}) to match im_levels, got {e.shape}"
         )
-    if not (np.all(x > 0) and np.all(np.diff(x) > 0)):
-        raise ParameterError("im_levels must be positive and strictly increasing [IM units]")
-    w = np.ones_like(e) if valid is None else np.asarray(valid, dtype=bool)
+    if not (np.all(np.isfinite(x) & (x > 0)) and np.all(np.diff(x) > 0)):
+        raise ParameterError("im_levels must be finite, positive and strictly increasing "
+                             "[IM units]")
+    w = np.ones_like(e) if valid is None else _reals(valid, "valid", "biuf").astype(bool)
     if w.shape != e.shape:
         raise ParameterError(f"valid must have the shape of exceeded {e.shape}, got {w.shape}")
     hit = e & w
@@ -632,7 +659,8 @@ def fit_ida(capacities, censored_at=None, *, method="mle") -> FragilityFit:
     .. [1] Baker, J. W. (2015). Efficient analytical fragility function fitting using dynamic
        structural analysis. *Earthquake Spectra*, 31(1), 579-599.
     """
-    c = np.asarray(capacities, dtype=float)
+    c = _reals(capacities, "capacities")
+    method = _method(method, "method", ("mle", "moments"))
     if c.ndim != 1:
         raise ParameterError(f"capacities must be 1-D, got shape {c.shape}")
     if np.any(np.isnan(c)):
@@ -647,7 +675,11 @@ def fit_ida(capacities, censored_at=None, *, method="mle") -> FragilityFit:
             raise ParameterError("capacities that never exceeded (inf) need censored_at")
         cmax = np.full_like(c, np.inf)
     else:
-        cmax = np.broadcast_to(np.asarray(censored_at, dtype=float), c.shape)
+        try:
+            cmax = np.broadcast_to(_reals(censored_at, "censored_at"), c.shape)
+        except ValueError:
+            raise ParameterError(f"censored_at must be a number or one per capacity "
+                                 f"({c.size})") from None
     censored = ~np.isfinite(c) | (c > cmax)
     if np.any(censored & ~(np.isfinite(cmax) & (cmax > 0))):
         raise ParameterError("censored records need a finite positive censored_at [IM units]")
@@ -801,15 +833,15 @@ def fit_cloud(im, edp, capacity, *, method="regression", capacity_beta=0.0) -> F
        fragility assessment using unscaled ground motion records. *Earthquake Engineering &
        Structural Dynamics*, 46(15), 2639-2663.
     """
-    x = np.asarray(im, dtype=float)
-    d = np.asarray(edp, dtype=float)
+    x = _reals(im, "im")
+    d = _reals(edp, "edp")
+    method = _method(method, "method", ("regression", "probit"))
+    capacity_beta = checks.real(capacity_beta, "capacity_beta", low=0.0)
     if x.ndim != 1 or d.shape != x.shape:
         raise ParameterError(f"im and edp must be 1-D of equal length, got {x.shape} and {d.shape}")
     if not np.all(np.isfinite(x) & (x > 0)):
         raise ParameterError("im must be finite and positive [IM units]")
-    capacity = float(capacity)
-    if not (np.isfinite(capacity) and capacity > 0):
-        raise ParameterError(f"capacity must be finite and positive, got {capacity!r}")
+    capacity = checks.real(capacity, "capacity", low=0.0, low_open=True)
     if method == "probit":
         if capacity_beta:
             raise ParameterError("capacity_beta is only used with method='regression'")
@@ -939,15 +971,27 @@ def bootstrap(
     .. [1] Efron, B., & Tibshirani, R. J. (1993). *An Introduction to the Bootstrap*. Chapman &
        Hall, ch. 13.
     """
-    if not 0 < confidence < 1:
-        raise ParameterError(f"confidence must be in (0, 1), got {confidence!r}")
+    if not callable(fit_function):
+        raise ParameterTypeError(f"fit_function must be a fitting function such as fit_ida, got "
+                                 f"{type(fit_function).__name__}")
+    if not isinstance(records, Mapping) or not records:
+        raise ParameterTypeError("records must be a non-empty mapping of per-record arrays, "
+                                 f"got {type(records).__name__}")
+    checks.real(confidence, "confidence", low=0.0, high=1.0, low_open=True, high_open=True)
+    n_boot = checks.whole(n_boot, "n_boot", low=1, high=1_000_000)
+    if im is not None:
+        im = _reals(im, "im")
     arrays = {name: np.asarray(value) for name, value in records.items()}
     lengths = {name: a.shape[0] if a.ndim else None for name, a in arrays.items()}
     n_rec = set(lengths.values())
     if len(n_rec) != 1 or None in n_rec:
         raise ParameterError(f"all record arrays need the same length along axis 0, got {lengths}")
     (n_rec,) = n_rec
-    rng = np.random.default_rng(seed)
+    try:
+        rng = np.random.default_rng(seed)
+    except (TypeError, ValueError) as exc:
+        raise ParameterTypeError(f"seed must be None, a non-negative integer (or sequence of "
+                                 f"them) or a numpy Generator, got {seed!r} ({exc})") from None
     base = fit_function(**arrays, **fit_kwargs)
     grid = (
         base.median
@@ -981,7 +1025,7 @@ def bootstrap(
         )
     medians, betas = np.asarray(medians), np.asarray(betas)
     q = 100 * np.array([(1 - confidence) / 2, (1 + confidence) / 2])
-    curves = lognormal_fragility(grid[None, :], medians[:, None], betas[:, None])
+    curves = _lognormal(grid[None, :], medians[:, None], betas[:, None])
     lower, upper = np.percentile(curves, q, axis=0)
     fit = replace(
         base,

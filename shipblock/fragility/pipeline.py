@@ -74,6 +74,13 @@ A selector names a record (catalogue id or its last part) and optionally ``im_le
 :func:`shipblock.simulate` on the batch's own input, one NetCDF file per run, and are listed in
 the result's ``history_file`` variable.
 
+Every value is checked when the file is loaded, with the key named: types, choices and the
+ranges of the module constants (:data:`MAX_BOOTSTRAP`, :data:`MAX_SEED`, :data:`MAX_CHUNK_SIZE`,
+:data:`MAX_HISTORIES`, :data:`MAX_RUNS`), of
+:data:`~shipblock.fragility.design.IM_LEVEL_RANGE` for the levels, of
+:data:`shipblock.system.FIELD_LIMITS` for the system and the sweep, and of
+:func:`shipblock.simulate` for the solver options.
+
 IM levels are converted to SI once, here: ``levels_g`` multiplies by
 :data:`shipblock.units.STANDARD_GRAVITY`; ``levels`` with ``units`` goes through
 :func:`shipblock.units.acceleration_to_si` (:func:`shipblock.units.velocity_to_si` for PGV).
@@ -99,7 +106,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from shipblock.errors import ShipblockError
+from shipblock.errors import ParameterError, ParameterTypeError, ShipblockError
 from shipblock.fragility.batch import (
     DEFAULT_CHUNK_SIZE,
     prepare_record,
@@ -108,6 +115,8 @@ from shipblock.fragility.batch import (
     summary_dataset,
 )
 from shipblock.fragility.design import (
+    IM_LEVEL_RANGE,
+    IM_MEASURES,
     SWEEP_PARAMETERS,
     SYSTEM_FIELDS,
     AnalysisDesign,
@@ -135,12 +144,25 @@ from shipblock.fragility.limit_states import (
     evaluate_limit_states,
     parse_limit_states,
 )
-from shipblock.fragility.store import ChunkStore, StoreError, open_results, write_dataset
+from shipblock.fragility.store import (
+    ChunkStore,
+    StoreError,
+    open_results,
+    remove_stale_temporaries,
+    write_dataset,
+)
 from shipblock.solver import DEFAULT_ATOL, DEFAULT_RTOL, DEFAULT_ZENO_OMEGA
+from shipblock.solver._inputs import check_options
 from shipblock.system import ShipBlockSystem
 from shipblock.units import STANDARD_GRAVITY, acceleration_to_si, velocity_to_si
 
 __all__ = [
+    "FIT_CHECKPOINT_INTERVAL",
+    "MAX_BOOTSTRAP",
+    "MAX_CHUNK_SIZE",
+    "MAX_HISTORIES",
+    "MAX_RUNS",
+    "MAX_SEED",
     "SCHEMA_VERSION",
     "HistoryRequest",
     "Pipeline",
@@ -164,6 +186,19 @@ DEFAULT_MAX_HISTORIES = 100
 DEFAULT_BOOTSTRAP = 200
 DEFAULT_CONFIDENCE = 0.9
 DEFAULT_SEED = 0
+
+#: Largest ``fit.bootstrap`` [resamples]: bounds converge with a few thousand; a larger number
+#: only makes the fits last.
+MAX_BOOTSTRAP = 10_000
+#: Largest ``fit.seed`` (seeds are 0 .. 2**63 - 1).
+MAX_SEED = 2**63 - 1
+#: Largest ``execution.chunk_size`` [runs].
+MAX_CHUNK_SIZE = 1_000_000
+#: Largest ``histories.max_runs`` [files].
+MAX_HISTORIES = 100_000
+#: Largest number of runs of one study (records x levels x swept values): the per-run results
+#: are held in memory, about 250 bytes a run.
+MAX_RUNS = 10_000_000
 
 
 class PipelineError(ShipblockError, ValueError):
@@ -275,7 +310,7 @@ def _check_table(table: Mapping, section: str, source: str) -> None:
         types = schema[key][0]
         if not _type_ok(value, types):
             want = " or ".join(_TYPE_NAMES[t] for t in dict.fromkeys(
-                float if t in (int, float) else t for t in types))
+                float if t is int and float in types else t for t in types))
             raise PipelineError(dotted, f"must be {want}, got {type(value).__name__} "
                                         f"{value!r}", source)
     for key, (_, required) in schema.items():
@@ -320,6 +355,33 @@ def _im_factor(measure: str, units: str, key: str, source: str) -> float:
         raise PipelineError(key, f"{exc} (for {measure.upper()})", source) from None
 
 
+def _in_range(levels, measure: str, key: str, source: str) -> tuple[float, ...]:
+    """SI ``levels`` checked against :data:`~shipblock.fragility.design.IM_LEVEL_RANGE`."""
+    low, high = IM_LEVEL_RANGE[measure]
+    name = key.split(".")[-1]
+    for i, level in enumerate(levels):
+        if not low <= level <= high:
+            if name.endswith("_g"):
+                value = f"{level / STANDARD_GRAVITY:g} g"
+                accepted = f"{low / STANDARD_GRAVITY:g} .. {high / STANDARD_GRAVITY:g} g"
+            else:
+                units = IM_MEASURES[measure][0]
+                value, accepted = f"{level:g} {units}", f"{low:g} .. {high:g} {units}"
+            raise PipelineError(key, f"{name}[{i}] = {value} is outside the accepted range "
+                                     f"{accepted} of {measure.upper()} levels", source)
+    return levels
+
+
+def _integer(table: Mapping, key: str, default: int, low: int, high: int, section: str,
+             source: str) -> int:
+    """``table[key]`` (or ``default``) checked to be an integer in ``[low, high]``."""
+    value = table.get(key, default)
+    if not low <= value <= high:
+        raise PipelineError(f"{section}.{key}", f"must be an integer in [{low}, {high}], got "
+                                                f"{value}", source)
+    return int(value)
+
+
 def _levels(design: Mapping, prefix: str, measure: str, source: str):
     """SI levels from ``<prefix>levels_g`` or ``<prefix>levels`` + ``units``."""
     kg, kl = f"{prefix}levels_g", f"{prefix}levels"
@@ -329,13 +391,15 @@ def _levels(design: Mapping, prefix: str, measure: str, source: str):
         if measure == "pgv":
             raise PipelineError(f"design.{kg}", "PGV levels are velocities: use levels = [...] "
                                                 "with units = 'm/s' or 'cm/s'", source)
-        return tuple(v * STANDARD_GRAVITY for v in _numbers(design[kg], f"design.{kg}", source))
+        si = tuple(v * STANDARD_GRAVITY for v in _numbers(design[kg], f"design.{kg}", source))
+        return _in_range(si, measure, f"design.{kg}", source)
     if kl in design:
         if "units" not in design:
             raise PipelineError("design.units", f"{kl!r} needs units (e.g. 'm/s^2', 'g', 'm/s')",
                                 source)
         f = _im_factor(measure, design["units"], "design.units", source)
-        return tuple(v * f for v in _numbers(design[kl], f"design.{kl}", source))
+        si = tuple(v * f for v in _numbers(design[kl], f"design.{kl}", source))
+        return _in_range(si, measure, f"design.{kl}", source)
     return None
 
 
@@ -474,14 +538,30 @@ def load_pipeline(path) -> Pipeline:
 
     Raises
     ------
+    ParameterTypeError
+        If ``path`` is not a path.
     PipelineError
-        If the file is missing, not TOML, or invalid; the message names the key.
+        If the file is missing, not a TOML text file, or invalid; the message names the file
+        and the key.
     """
+    if not isinstance(path, str | os.PathLike):
+        raise ParameterTypeError(f"path must be the pipeline file (a str or os.PathLike), got "
+                                 f"{type(path).__name__} {path!r}")
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        data = path.read_bytes()
     except OSError as exc:
         raise PipelineError("", f"cannot read the pipeline file ({exc})", str(path)) from exc
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise PipelineError("", f"is not a pipeline file: not UTF-8 text (byte 0x{data[exc.start]:02x} "
+                                f"at offset {exc.start}); a pipeline is a TOML text file",
+                            str(path)) from None
+    if "\x00" in text:
+        raise PipelineError("", f"is not a pipeline file: binary data (a NUL byte at offset "
+                                f"{text.index(chr(0))}); a pipeline is a TOML text file",
+                            str(path))
     return parse_pipeline(text, base=path.resolve().parent, source=str(path))
 
 
@@ -538,6 +618,9 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
     if not ids or not all(isinstance(i, str) for i in ids):
         raise PipelineError("records.ids", "must be a non-empty list of record ids (strings)",
                             source)
+    repeated = sorted({i for i in ids if ids.count(i) > 1})
+    if repeated:
+        raise PipelineError("records.ids", f"repeats {', '.join(repeated)}", source)
     missing = [i for i in ids if i not in entries]
     if missing:
         raise PipelineError("records.ids", f"not in the catalogue: {', '.join(missing)}; "
@@ -551,7 +634,12 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
     response = rec.get("response", "sensitivity")
     if response not in ("sensitivity", "full"):
         raise PipelineError("records.response", "must be 'sensitivity' or 'full'", source)
-    azimuth = float(rec["azimuth"]) if "azimuth" in rec else None
+    azimuth = None
+    if "azimuth" in rec:
+        azimuth = float(rec["azimuth"])
+        if not -360.0 <= azimuth <= 360.0:  # also false for NaN
+            raise PipelineError("records.azimuth", f"must be a finite angle in [-360, 360] [deg "
+                                                   f"clockwise from north], got {azimuth}", source)
 
     # processing
     chain = None
@@ -591,7 +679,12 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
     try:
         system = ShipBlockSystem(**sys_table)
     except (TypeError, ValueError) as exc:
-        raise PipelineError("system", str(exc), source) from None
+        field = str(exc).split()[0]
+        given = {"half_width": "slenderness", "block_mass": "mass_ratio"}.get(field)
+        if given in doc["system"]:
+            field = given  # the field was computed from the convenience given
+        key = f"system.{field}" if field in _SCHEMA["system"] else "system"
+        raise PipelineError(key, str(exc), source) from None
 
     # sweep
     sweep = []
@@ -629,7 +722,11 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
     try:
         intensity.validate()
     except ValueError as exc:
-        key = "design.levels_g" if "levels" in str(exc) and "levels_g" in d else "design"
+        field = str(exc).split()[0].split("[")[0].rstrip(":")
+        if field in ("levels", "vertical_levels"):
+            key = f"design.{field}_g" if f"{field}_g" in d else f"design.{field}"
+        else:
+            key = f"design.{field}" if field in _SCHEMA["design"] else "design"
         raise PipelineError(key, str(exc), source) from None
     cloud_method = d.get("cloud_method", "probit")
     if cloud_method not in ("probit", "regression"):
@@ -644,10 +741,19 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
         except ValueError as exc:
             raise PipelineError("design.stripes", str(exc), source) from None
     design = AnalysisDesign(tuple(ids), intensity, system, tuple(sweep), stripes)
+    if design.n_cases > MAX_RUNS:
+        sizes = " x ".join(f"{n} {dim}" for n, dim in zip(design.shape, ("records", "levels",
+                                                                          *design.sweep_names),
+                                                          strict=True))
+        raise PipelineError("sweep" if sweep else "design",
+                            f"the study has {design.n_cases:,} runs ({sizes}), more than "
+                            f"{MAX_RUNS:,}; split it into several pipelines", source)
     try:
         design.validate()
     except ValueError as exc:
-        raise PipelineError("sweep", str(exc), source) from None
+        swept = [name for name, _ in sweep if repr(name) in str(exc) or f"'{name}'" in str(exc)]
+        raise PipelineError(f"sweep.{swept[0]}" if len(swept) == 1 else "sweep", str(exc),
+                            source) from None
 
     # limit states
     try:
@@ -667,32 +773,32 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
     # fit, solver, execution
     f = doc.get("fit", {})
     fit = {
-        "bootstrap": f.get("bootstrap", DEFAULT_BOOTSTRAP),
+        "bootstrap": _integer(f, "bootstrap", DEFAULT_BOOTSTRAP, 0, MAX_BOOTSTRAP, "fit", source),
         "confidence": float(f.get("confidence", DEFAULT_CONFIDENCE)),
-        "seed": f.get("seed", DEFAULT_SEED),
+        "seed": _integer(f, "seed", DEFAULT_SEED, 0, MAX_SEED, "fit", source),
         "ida_method": f.get("ida_method", "mle"),
         "cloud_method": cloud_method,
     }
-    if fit["bootstrap"] < 0:
-        raise PipelineError("fit.bootstrap", "must be >= 0", source)
     if not 0 < fit["confidence"] < 1:
-        raise PipelineError("fit.confidence", "must lie in (0, 1)", source)
+        raise PipelineError("fit.confidence", f"must lie in (0, 1), got {fit['confidence']}",
+                            source)
     if fit["ida_method"] not in ("mle", "moments"):
         raise PipelineError("fit.ida_method", "must be 'mle' or 'moments'", source)
     s = doc.get("solver", {})
     solver = {"rtol": float(s.get("rtol", DEFAULT_RTOL)),
               "atol": float(s.get("atol", DEFAULT_ATOL)),
               "zeno_omega": float(s.get("zeno_omega", DEFAULT_ZENO_OMEGA))}
-    if not 0 < solver["rtol"] < 1:
-        raise PipelineError("solver.rtol", "must lie in (0, 1)", source)
-    if not solver["atol"] > 0:
-        raise PipelineError("solver.atol", "must be > 0", source)
-    if not solver["zeno_omega"] >= 0:
-        raise PipelineError("solver.zeno_omega", "must be >= 0 [rad/s]", source)
+    try:
+        check_options(**solver)
+    except ParameterError as exc:
+        raise PipelineError(f"solver.{str(exc).split()[0]}", str(exc), source) from None
     ex = doc.get("execution", {})
-    chunk_size = ex.get("chunk_size", DEFAULT_CHUNK_SIZE)
-    if chunk_size < 1:
-        raise PipelineError("execution.chunk_size", "must be >= 1", source)
+    chunk_size = _integer(ex, "chunk_size", DEFAULT_CHUNK_SIZE, 1, MAX_CHUNK_SIZE, "execution",
+                          source)
+    scheduler = ex.get("scheduler")
+    if scheduler is not None and not scheduler.strip():
+        raise PipelineError("execution.scheduler", "must be a Dask scheduler address such as "
+                                                   "'tcp://host:8786', got an empty string", source)
     histories = None
     if "histories" in doc:
         histories = _parse_histories(doc["histories"], design, limit_states, base, source)
@@ -700,9 +806,20 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
         source=source, text=text, document=doc, catalogue=catalogue, azimuth=azimuth,
         horizontal=horizontal, response=response, chain=chain, design=design,
         limit_states=limit_states, fit=fit, solver=solver, chunk_size=int(chunk_size),
-        scheduler=ex.get("scheduler"), output=(base / doc["output"]).resolve(),
+        scheduler=scheduler, output=_output_path(doc["output"], base, source),
         histories=histories,
     )
+
+
+def _output_path(value: str, base: Path, source: str, key: str = "output") -> Path:
+    """The output file, absolute: a file name (not empty, not a folder)."""
+    if not value.strip() or value.endswith(("/", "\\")) or Path(value).name in ("", ".", ".."):
+        raise PipelineError(key, f"must name a NetCDF file such as 'results/study.nc', got "
+                                 f"{value!r}", source)
+    path = (base / value).resolve()
+    if path.is_dir():
+        raise PipelineError(key, f"{path} is a folder; name a NetCDF file in it", source)
+    return path
 
 
 def _parse_histories(table, design, limit_states, base, source) -> HistoryRequest:
@@ -723,9 +840,8 @@ def _parse_histories(table, design, limit_states, base, source) -> HistoryReques
                                 f"limit states: {', '.join(names)}", source)
     if not cases and not exceeding:
         raise PipelineError("histories", "select runs with 'runs' and/or 'exceeding'", source)
-    max_runs = table.get("max_runs", DEFAULT_MAX_HISTORIES)
-    if max_runs < 1:
-        raise PipelineError("histories.max_runs", "must be >= 1", source)
+    max_runs = _integer(table, "max_runs", DEFAULT_MAX_HISTORIES, 1, MAX_HISTORIES, "histories",
+                        source)
     directory = (base / table["directory"]).resolve() if "directory" in table else None
     return HistoryRequest(tuple(dict.fromkeys(cases)), tuple(exceeding), int(max_runs),
                           directory)
@@ -805,7 +921,71 @@ def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng):
     return out, capacity
 
 
-def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fit_opts) -> dict:
+_FIT_FLOATS = ("median", "beta", "median_lower", "median_upper", "beta_lower", "beta_upper")
+_FIT_INTS = ("n_fit_records", "bootstrap_failed")
+_FIT_STRINGS = ("fit_method", "fit_error")
+
+#: Fitted results are written to the partial-results directory at most this often [s] (and
+#: once more when the fits are done): a kill after the batch loses at most this much fitting.
+FIT_CHECKPOINT_INTERVAL = 1.0
+
+
+class _FitCheckpoint:
+    """Fitted results of finished (limit state, sweep point) pairs, kept in a ChunkStore.
+
+    Fit ``f = i * n_points + c`` is limit state ``i`` at sweep point ``c``; each file of the
+    store's ``"fit"`` group holds some fits (those finished since the previous file), so the
+    files' names say nothing about what they hold and a file is never rewritten.
+    """
+
+    def __init__(self, store: ChunkStore, n_records: int):
+        self.store = store
+        self.n_records = n_records
+        self.pending: dict[int, tuple[dict, np.ndarray]] = {}
+        self.last = time.monotonic()
+        self.next_id = max(store.completed("fit"), default=-1) + 1
+
+    def load(self) -> dict[int, tuple[dict, np.ndarray]]:
+        """Fits done by an earlier, interrupted run: ``{f: (results, capacity column)}``."""
+        done = {}
+        for k in sorted(self.store.completed("fit")):
+            try:
+                fits, arrays = self.store.read(k, "fit")
+                capacity = np.asarray(arrays["capacity"], dtype=float).reshape(
+                    len(fits), self.n_records)
+                rows = [dict(zip(_FIT_FLOATS + _FIT_INTS + _FIT_STRINGS, values, strict=True))
+                        for values in zip(*(arrays[n].tolist() for n in
+                                             _FIT_FLOATS + _FIT_INTS + _FIT_STRINGS),
+                                          strict=True)]
+            except (StoreError, KeyError, ValueError) as exc:
+                logger.warning("fitted results %d unusable (%s); fitting again", k, exc)
+                self.store.discard(k, "fit")
+                continue
+            for f, row, col in zip(fits.tolist(), rows, capacity, strict=True):
+                done[f] = (row, col)
+        return done
+
+    def add(self, f: int, result: dict, capacity: np.ndarray) -> None:
+        self.pending[f] = (result, capacity)
+        if time.monotonic() - self.last >= FIT_CHECKPOINT_INTERVAL:
+            self.flush()
+
+    def flush(self) -> None:
+        if self.pending:
+            fits = np.array(list(self.pending), dtype=np.int64)
+            rows = [r for r, _ in self.pending.values()]
+            arrays = {n: np.array([r[n] for r in rows], dtype=float) for n in _FIT_FLOATS}
+            arrays.update({n: np.array([r[n] for r in rows], dtype=np.int64) for n in _FIT_INTS})
+            arrays.update({n: np.array([r[n] for r in rows], dtype=str) for n in _FIT_STRINGS})
+            arrays["capacity"] = np.stack([c for _, c in self.pending.values()])
+            self.store.write(self.next_id, fits, arrays, group="fit")
+            self.next_id += 1
+            self.pending = {}
+        self.last = time.monotonic()
+
+
+def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fit_opts,
+                        store: ChunkStore | None = None) -> dict:
     """Exceedance, fitted median/beta and bootstrap bounds of every limit state.
 
     Parameters
@@ -819,6 +999,11 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
         The limit states (the ``limit_state`` dimension).
     fit_opts : dict
         ``bootstrap`` (resamples), ``confidence``, ``seed``, ``ida_method``, ``cloud_method``.
+    store : ChunkStore, optional
+        The run's partial-results directory (opened): fitted results are written to it as they
+        are done (at most every :data:`FIT_CHECKPOINT_INTERVAL` seconds), and those it holds
+        from an interrupted run are used instead of fitted again. Each fit is a function of
+        its own data and seed only, so the results are the same bit for bit.
 
     Returns
     -------
@@ -844,25 +1029,38 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
     fields["bootstrap_failed"] = np.zeros((n_ls, *sweep_shape), dtype=np.int64)
     fields["fit_method"] = np.full((n_ls, *sweep_shape), "", dtype=object)
     fields["fit_error"] = np.full((n_ls, *sweep_shape), "", dtype=object)
-    capacity = np.full((n_ls, len(design.records), *sweep_shape), np.nan)
+    n_records = len(design.records)
+    capacity = np.full((n_ls, n_records, *sweep_shape), np.nan)
     im = ds["achieved_im"].values if not intensity.scaled else None
+    checkpoint = None if store is None else _FitCheckpoint(store, n_records)
+    done = {} if checkpoint is None else checkpoint.load()
+    if done:
+        logger.info("resuming: %d of %d fits already done", len(done),
+                    n_ls * design.n_systems)
     for i, ls in enumerate(limit_states):
         e_all = ex[ls.name].exceeded.transpose(*design.dims).values
         w_all = ex[ls.name].valid.transpose(*design.dims).values
         edp_all = ds[ls.edp].transpose(*design.dims).values
         lead = e_all.ndim - len(sweep_shape)
         for c, combo in enumerate(itertools.product(*(range(n) for n in sweep_shape))):
-            sel = (slice(None),) * lead + combo
-            rng = np.random.default_rng([int(fit_opts["seed"]), i, c])
-            res, caps = _fit_one(kind, e_all[sel], w_all[sel], levels, im, edp_all[sel], ls,
-                                 fit_opts, rng)
+            f = i * design.n_systems + c
+            if f in done:
+                res, col = done[f]
+            else:
+                sel = (slice(None),) * lead + combo
+                rng = np.random.default_rng([int(fit_opts["seed"]), i, c])
+                res, caps = _fit_one(kind, e_all[sel], w_all[sel], levels, im, edp_all[sel],
+                                     ls, fit_opts, rng)
+                col = np.full(n_records, np.nan)
+                if caps is not None:
+                    col[w_all[sel].any(axis=1)] = caps.capacity
+                if checkpoint is not None:
+                    checkpoint.add(f, res, col)
             for k, v in res.items():
                 fields[k][(i, *combo)] = v
-            if caps is not None:
-                keep = w_all[sel].any(axis=1)
-                col = np.full(len(design.records), np.nan)
-                col[keep] = caps.capacity
-                capacity[(i, slice(None), *combo)] = col
+            capacity[(i, slice(None), *combo)] = col
+    if checkpoint is not None:
+        checkpoint.flush()
     im_units = intensity.units
     dims_fit = ("limit_state", *sweep_dims)
     info = {
@@ -949,6 +1147,35 @@ def _fingerprint(pipe: Pipeline, records) -> str:
     return h.hexdigest()
 
 
+def _prepare_output_folder(out_path: Path, source: str) -> None:
+    """Create the output's folder, check it is writable and remove stale temporary files.
+
+    Done before any work, so that an output that cannot be written fails at once, not after
+    the batch.
+    """
+    try:
+        out_path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise PipelineError("output", f"cannot create the folder of {out_path} ({exc})",
+                            source) from None
+    if not os.access(out_path.parent, os.W_OK | os.X_OK):
+        raise PipelineError("output", f"cannot write in the folder {out_path.parent}", source)
+    for stale in remove_stale_temporaries(out_path):
+        logger.info("removed %s, left by an interrupted write of %s", stale.name, out_path.name)
+
+
+def _dask_client_class(scheduler: str, source: str):
+    """``distributed.Client``, or a PipelineError saying which extra to install."""
+    try:
+        from distributed import Client
+    except ImportError as exc:
+        raise PipelineError(
+            "execution.scheduler",
+            f"running on the Dask scheduler {scheduler!r} needs Dask, which is not installed "
+            f"({exc}); install it with: pip install \"shipblock[dask]\"", source) from None
+    return Client
+
+
 def _loader(entry, pipe: Pipeline):
     def load():
         kwargs = {"response": pipe.response}
@@ -968,8 +1195,10 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     path : str or os.PathLike
         The pipeline TOML file.
     output : str or os.PathLike, optional
-        Output NetCDF file; overrides the file's ``output``. Finished chunks are kept in
-        ``<output>.partial/`` until the final file is written; rerunning resumes from them.
+        Output NetCDF file; overrides the file's ``output``. Finished chunks, and then the
+        fitted results, are kept in ``<output>.partial/`` until the final file is written;
+        rerunning resumes from them. Temporary files a killed final write left beside the
+        output (``.<name>.<random>.tmp``) are removed when the run starts.
     client : distributed.Client, optional
         Run the chunks as tasks on this Dask client.
     scheduler : str, optional
@@ -995,36 +1224,54 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     Raises
     ------
     PipelineError
-        If the pipeline is invalid, or the partial directory belongs to another run.
+        If the pipeline is invalid, the output cannot be written, Dask is asked for but not
+        installed (``pip install "shipblock[dask]"``) or its scheduler cannot be reached, every
+        record was left out, or the partial directory belongs to another run. All of these
+        are found before the batch starts.
     """
     from shipblock import __version__
     from shipblock.catalogue import load_catalogue
     from shipblock.processing import DEFAULT_CHAIN
 
+    for name, value, types, what in (("output", output, str | os.PathLike, "a file path"),
+                                     ("scheduler", scheduler, str, "a scheduler address"),
+                                     ("timings", timings, dict, "a dict")):
+        if value is not None and not isinstance(value, types):
+            raise ParameterTypeError(f"{name} must be {what} or None, got "
+                                     f"{type(value).__name__} {value!r}")
     clock = _StageClock(timings)
     pipe = load_pipeline(path)
-    out_path = Path(output).resolve() if output is not None else pipe.output
+    out_path = (pipe.output if output is None
+                else _output_path(os.fspath(output), Path.cwd(), "run_pipeline(output=...)"))
+    _prepare_output_folder(out_path, pipe.source)
+    scheduler = scheduler or pipe.scheduler
+    connect = _dask_client_class(scheduler, pipe.source) if client is None and scheduler else None
     design = pipe.design
     entries = load_catalogue(pipe.catalogue)
     records = [
         prepare_record(rid, _loader(entries[rid], pipe), pipe.chain, design.intensity)
         for rid in design.records
     ]
+    if all(r.error is not None for r in records):
+        reasons = "; ".join(f"{r.id}: {r.error}" for r in records)
+        raise PipelineError("records.ids", f"every record was left out, so there is nothing to "
+                                           f"run: {reasons}", pipe.source)
     fingerprint = _fingerprint(pipe, records)
-    store = ChunkStore(out_path.with_name(out_path.name + ".partial"), fingerprint)
-    try:
-        store.open({"n_cases": design.n_cases, "chunk_size": pipe.chunk_size,
-                    "pipeline": pipe.source})
-    except StoreError as exc:
-        raise PipelineError("output", str(exc), pipe.source) from None
-    clock.lap("records")
     own_client = None
-    scheduler = scheduler or pipe.scheduler
-    if client is None and scheduler:
-        from distributed import Client
-
-        client = own_client = Client(scheduler)
+    if connect is not None:
+        try:
+            client = own_client = connect(scheduler)
+        except (OSError, TimeoutError) as exc:
+            raise PipelineError("execution.scheduler", f"cannot connect to the Dask scheduler "
+                                                       f"{scheduler!r}: {exc}", pipe.source) from None
     try:
+        store = ChunkStore(out_path.with_name(out_path.name + ".partial"), fingerprint)
+        try:
+            store.open({"n_cases": design.n_cases, "chunk_size": pipe.chunk_size,
+                        "pipeline": pipe.source})
+        except StoreError as exc:
+            raise PipelineError("output", str(exc), pipe.source) from None
+        clock.lap("records")
         results = run_batch(design, records, store, chunk_size=pipe.chunk_size, client=client,
                             progress=progress, solver_options=pipe.solver, timings=timings)
     finally:
@@ -1034,7 +1281,7 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     ds = summary_dataset(design, records, results)
     ds = ds.assign_coords({k: xr.Variable(*v) for k, v in _limit_state_coords(
         pipe.limit_states).items()})
-    ds = ds.assign(fragility_variables(ds, design, pipe.limit_states, pipe.fit))
+    ds = ds.assign(fragility_variables(ds, design, pipe.limit_states, pipe.fit, store))
     chain = [dict(e) for e in (DEFAULT_CHAIN if pipe.chain is None else pipe.chain)]
     intensity = design.intensity
     ds.attrs = {

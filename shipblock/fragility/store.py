@@ -3,14 +3,20 @@
 Two layers, both crash-safe:
 
 * :class:`ChunkStore` keeps one small ``.npz`` file per finished chunk in a directory
-  (``<output>.partial/``). Each file is written to a temporary name in the same directory and
-  moved into place with :func:`os.replace`, which is atomic on POSIX and Windows, so a file with
-  the final name is always complete. A ``manifest.json`` holds the fingerprint of the run (the
-  pipeline, the shipblock version and the prepared records); a rerun with another fingerprint
-  refuses to mix results.
+  (``<output>.partial/``), and in the same way the fitted fragility results after the batch
+  (group ``"fit"``, see :func:`shipblock.fragility.pipeline.fragility_variables`). Each file is
+  written to a temporary name in the same directory and moved into place with
+  :func:`os.replace`, which is atomic on POSIX and Windows, so a file with the final name is
+  always complete. A ``manifest.json`` holds the fingerprint of the run (the pipeline, the
+  shipblock version and the prepared records); a rerun with another fingerprint refuses to mix
+  results.
 * :func:`write_dataset` writes the final :class:`xarray.Dataset` to NetCDF-4 (engine
   ``netcdf4``, zlib compression of every numeric variable) through a temporary file and
   :func:`os.replace`; :func:`open_results` reads it back.
+
+A run killed while it writes leaves its temporary file (``.<name>.<random>.tmp``) behind; the
+next run removes those of its own files (:func:`remove_stale_temporaries`,
+:meth:`ChunkStore.open`), never anything else.
 
 Every variable and coordinate of a result dataset carries ``units`` and ``long_name``;
 :data:`RUN_VARIABLES` lists those of the per-run summaries.
@@ -19,8 +25,10 @@ Every variable and coordinate of a result dataset carries ``units`` and ``long_n
 from __future__ import annotations
 
 import contextlib
+import glob
 import json
 import os
+import re
 import shutil
 import tempfile
 import zipfile
@@ -40,6 +48,7 @@ __all__ = [
     "StoreError",
     "check_metadata",
     "open_results",
+    "remove_stale_temporaries",
     "write_dataset",
 ]
 
@@ -47,7 +56,10 @@ __all__ = [
 COMPRESSION_LEVEL = 4
 
 _MANIFEST = "manifest.json"
-_CHUNK_PREFIX = "chunk-"
+#: File groups of a partial-results directory: batch chunks and fitted results.
+_GROUPS = ("chunk", "fit")
+#: The random part :func:`tempfile.mkstemp` puts in a name.
+_RANDOM = r"[A-Za-z0-9_]{8}"
 
 
 class StoreError(ShipblockError, ValueError):
@@ -92,9 +104,48 @@ RUN_VARIABLES: dict[str, tuple[str, str]] = _run_variables()
 # --------------------------------------------------------------------------------------------
 
 
+def _temporary(path: Path) -> tuple[int, str]:
+    """A new temporary file for ``path``, in its folder: ``.<name>.<random>.tmp``."""
+    return tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+
+
+def _is_temporary_of(name: str, target: str) -> bool:
+    """Whether the file name ``name`` is one of :func:`_temporary`'s names for ``target``."""
+    return re.fullmatch(re.escape(f".{target}.") + _RANDOM + r"\.tmp", name) is not None
+
+
+def remove_stale_temporaries(path) -> list[Path]:
+    """Delete the temporary files a killed writer of ``path`` left in its folder.
+
+    Only files named as :func:`write_dataset` names its temporary files for this very output
+    (``.<name>.<8 random characters>.tmp``) are removed. Call it before a run starts writing
+    ``path``: a temporary file of a writer still running would be removed too.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output file.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files removed.
+    """
+    path = Path(path)
+    removed = []
+    if not path.parent.is_dir():
+        return removed
+    for candidate in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"):
+        if _is_temporary_of(candidate.name, path.name) and candidate.is_file():
+            with contextlib.suppress(FileNotFoundError):
+                candidate.unlink()
+                removed.append(candidate)
+    return removed
+
+
 def _atomic_write(path: Path, write) -> None:
     """Write ``path`` through a temporary file in the same directory and ``os.replace``."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    fd, tmp = _temporary(path)
     try:
         with os.fdopen(fd, "wb") as fh:
             write(fh)
@@ -130,6 +181,8 @@ class ChunkStore:
     def open(self, info: dict | None = None) -> ChunkStore:
         """Create the directory and its manifest, or check the manifest of an existing one.
 
+        Temporary files a killed writer left in the directory are removed.
+
         Parameters
         ----------
         info : dict, optional
@@ -146,6 +199,11 @@ class ChunkStore:
             If an existing manifest has another fingerprint or cannot be read.
         """
         self.directory.mkdir(parents=True, exist_ok=True)
+        own = re.compile(r"\.(?:" + "|".join(_GROUPS) + r")-\d{6}\.npz\." + _RANDOM + r"\.tmp")
+        for candidate in self.directory.glob(".*.tmp"):
+            if own.fullmatch(candidate.name) or _is_temporary_of(candidate.name, _MANIFEST):
+                with contextlib.suppress(FileNotFoundError):
+                    candidate.unlink()
         manifest = self.directory / _MANIFEST
         if manifest.exists():
             try:
@@ -163,11 +221,18 @@ class ChunkStore:
         _atomic_write(manifest, lambda fh: fh.write(text.encode()))
         return self
 
-    def _path(self, chunk_id: int) -> Path:
-        return self.directory / f"{_CHUNK_PREFIX}{int(chunk_id):06d}.npz"
+    def _path(self, chunk_id: int, group: str = "chunk") -> Path:
+        if group not in _GROUPS:
+            raise StoreError(f"unknown file group {group!r}; groups: {', '.join(_GROUPS)}")
+        return self.directory / f"{group}-{int(chunk_id):06d}.npz"
 
-    def completed(self) -> set[int]:
-        """Ids of the chunks whose files exist.
+    def completed(self, group: str = "chunk") -> set[int]:
+        """Ids of the chunks (of a file group) whose files exist.
+
+        Parameters
+        ----------
+        group : {"chunk", "fit"}
+            Batch chunks, or fitted results.
 
         Returns
         -------
@@ -175,13 +240,14 @@ class ChunkStore:
         """
         if not self.directory.is_dir():
             return set()
+        prefix = self._path(0, group).name[:-len("000000.npz")]
         out = set()
-        for p in self.directory.glob(f"{_CHUNK_PREFIX}*.npz"):
+        for p in self.directory.glob(f"{prefix}*.npz"):
             with contextlib.suppress(ValueError):
-                out.add(int(p.stem[len(_CHUNK_PREFIX):]))
+                out.add(int(p.stem[len(prefix):]))
         return out
 
-    def write(self, chunk_id: int, cases, arrays: dict) -> None:
+    def write(self, chunk_id: int, cases, arrays: dict, group: str = "chunk") -> None:
         """Write one finished chunk atomically.
 
         The float arrays are stored as the rows of one 2-D array (a few large entries in the
@@ -195,7 +261,10 @@ class ChunkStore:
             Case numbers of the chunk.
         arrays : dict of numpy.ndarray
             Per-case results (float arrays of the length of ``cases``) and optional string
-            arrays (``run_error``).
+            arrays (``run_error``) or other arrays.
+        group : {"chunk", "fit"}
+            Batch chunk (``cases`` are case numbers) or fitted results (``cases`` are fit
+            numbers).
         """
         cases = np.asarray(cases, dtype=np.int64)
         payload = {"cases": cases}
@@ -214,15 +283,17 @@ class ChunkStore:
         if rows:
             payload["names"] = np.array(names)
             payload["values"] = np.stack(rows)
-        _atomic_write(self._path(chunk_id), lambda fh: np.savez(fh, **payload))
+        _atomic_write(self._path(chunk_id, group), lambda fh: np.savez(fh, **payload))
 
-    def read(self, chunk_id: int) -> tuple[np.ndarray, dict]:
+    def read(self, chunk_id: int, group: str = "chunk") -> tuple[np.ndarray, dict]:
         """Read a finished chunk.
 
         Parameters
         ----------
         chunk_id : int
             The chunk number.
+        group : {"chunk", "fit"}
+            Its file group.
 
         Returns
         -------
@@ -234,7 +305,7 @@ class ChunkStore:
         StoreError
             If the file is unreadable (it is then best deleted and recomputed).
         """
-        path = self._path(chunk_id)
+        path = self._path(chunk_id, group)
         try:
             with np.load(path, allow_pickle=False) as data:
                 cases = data["cases"]
@@ -246,10 +317,10 @@ class ChunkStore:
             raise StoreError(f"{path}: unreadable chunk file ({exc})") from exc
         return cases, arrays
 
-    def discard(self, chunk_id: int) -> None:
+    def discard(self, chunk_id: int, group: str = "chunk") -> None:
         """Delete one chunk file (e.g. an unreadable one)."""
         with contextlib.suppress(FileNotFoundError):
-            self._path(chunk_id).unlink()
+            self._path(chunk_id, group).unlink()
 
     def remove(self) -> None:
         """Delete the whole directory."""
@@ -309,7 +380,7 @@ def write_dataset(ds: xr.Dataset, path) -> Path:
     check_metadata(ds)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    fd, tmp = _temporary(path)
     os.close(fd)
     try:
         ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=_encoding(ds))

@@ -13,10 +13,17 @@ from collections.abc import Sequence
 import numba
 import numpy as np
 
-from shipblock.errors import ParameterError
+from shipblock import checks
+from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.result import Energy, EventLog, SimulationResult, failure_name
 from shipblock.solver import _kernel as K
-from shipblock.solver._inputs import RecordSet, as_acceleration, check_dt, check_options
+from shipblock.solver._inputs import (
+    RecordSet,
+    as_acceleration,
+    check_dt,
+    check_initial_state,
+    check_options,
+)
 from shipblock.system import P_THC, ShipBlockSystem
 
 #: Default relative tolerance of the rocking integration [-].
@@ -49,6 +56,11 @@ SUMMARY_FIELDS = {
 MODE_TIME_FIELDS = [f"time_in_mode_{m}" for m in range(1, 9)]
 
 
+def _is_motion(value) -> bool:
+    """Whether ``value`` is a :class:`shipblock.motion.GroundMotion` (without importing obspy)."""
+    return all(hasattr(value, a) for a in ("horizontal", "vertical", "dt"))
+
+
 def simulate(
     system: ShipBlockSystem,
     ax,
@@ -73,20 +85,26 @@ def simulate(
     system : ShipBlockSystem
         The ship-block system.
     ax : array_like or GroundMotion
-        Horizontal ground acceleration at ``t_k = k dt`` [m/s^2], positive to the right. A
-        :class:`shipblock.motion.GroundMotion` may be passed instead, in which case its
-        horizontal, vertical and dt are used.
+        Horizontal ground acceleration at ``t_k = k dt`` [m/s^2], positive to the right; at
+        least 2 samples, each finite and within :data:`shipblock.checks.MAX_ACCELERATION`
+        (100 g). A :class:`shipblock.motion.GroundMotion` may be passed instead, in which case
+        its horizontal, vertical and dt are used (``ay`` and ``dt`` are then not given).
     ay : array_like or None, optional
-        Vertical ground acceleration [m/s^2], positive up; ``None`` for none.
+        Vertical ground acceleration [m/s^2], positive up; ``None`` for none. Same length and
+        limits as ``ax``.
     dt : float
-        Sample interval [s].
+        Sample interval [s], within :data:`shipblock.checks.MIN_TIME_STEP` ..
+        :data:`shipblock.checks.MAX_TIME_STEP` (1e-4 .. 1 s).
     rtol, atol : float, optional
-        Relative and absolute error tolerance of the rocking phases.
+        Relative and absolute error tolerance of the rocking phases; ``rtol`` in [1e-14, 1),
+        ``atol`` in [1e-16, 1].
     zeno_omega : float, optional
-        Rocking stops when an impact leaves less angular velocity than this [rad/s].
+        Rocking stops when an impact leaves less angular velocity than this [rad/s]; in
+        [0, 1000].
     initial_state : sequence of 6 float, optional
         ``(x_b, theta, x_s, v_b, theta_dot, v_s)`` at t = 0 [m, rad, m, m/s, rad/s, m/s];
-        default at rest. ``|theta|`` must be below the critical angle.
+        default at rest. ``|theta|`` must be below the critical angle, displacements within
+        100 m, velocities within 100 m/s and 100 rad/s.
 
     Returns
     -------
@@ -95,9 +113,13 @@ def simulate(
 
     Raises
     ------
-    ValueError
-        For empty or non-finite accelerations, ``dt <= 0`` or ``ax``/``ay`` of different length;
-        the message names the argument.
+    ParameterTypeError
+        For an argument of the wrong type (``system`` not a :class:`ShipBlockSystem`, a string
+        for a number...).
+    ParameterError
+        For too short, non-finite or implausible accelerations, ``dt`` or a tolerance out of its
+        range, ``ax``/``ay`` of different length or an implausible initial state. Both are
+        :class:`ValueError`; the message names the argument and what it expects.
 
     Examples
     --------
@@ -111,15 +133,19 @@ def simulate(
     >>> res.failure is None
     True
     """
-    if dt is None and hasattr(ax, "horizontal") and hasattr(ax, "dt"):
-        motion = ax
-        ax, ay, dt = motion.horizontal, motion.vertical, motion.dt
-    if dt is None:
-        raise ParameterError("dt [s] is required when ax is an array")
     if not isinstance(system, ShipBlockSystem):
-        raise TypeError(f"system must be a ShipBlockSystem, got {type(system).__name__}")
-    check_dt(dt)
-    check_options(rtol, atol, zeno_omega)
+        raise ParameterTypeError(f"system must be a ShipBlockSystem, got {type(system).__name__}")
+    if _is_motion(ax):
+        motion = ax
+        for name, value in (("ay", ay), ("dt", dt)):
+            if value is not None:
+                raise ParameterError(f"{name} must not be given with a GroundMotion as ax: the "
+                                     f"motion holds its own (vertical and dt)")
+        ax, ay, dt = motion.horizontal, motion.vertical, motion.dt
+    elif dt is None:
+        raise ParameterError("dt [s] is required when ax is an array")
+    dt = check_dt(dt)
+    rtol, atol, zeno_omega = check_options(rtol, atol, zeno_omega)
     ax = as_acceleration(ax, "ax")
     if ay is None:
         ay_arr = ax  # a stand-in the kernel never reads (has_ay False): no zeros to allocate
@@ -127,19 +153,12 @@ def simulate(
     else:
         ay_arr = as_acceleration(ay, "ay")
         if ay_arr.size != ax.size:
-            raise ParameterError(f"ax and ay must have the same length, got {ax.size} and {ay_arr.size}")
+            raise ParameterError(f"ay must have the same length as ax ({ax.size} samples), got "
+                                 f"{ay_arr.size}")
         has_ay = True
     y_init = np.zeros(6)
     if initial_state is not None:
-        y_init = np.asarray(initial_state, dtype=float)
-        if y_init.shape != (6,) or not np.isfinite(y_init).all():
-            raise ParameterError(
-                f"initial_state must be 6 finite numbers (x_b, theta, x_s, v_b, theta_dot, v_s), got {initial_state!r}"
-            )
-        if abs(y_init[1]) >= system.critical_angle:
-            raise ParameterError(
-                f"initial_state theta={y_init[1]} is beyond the critical angle {system.critical_angle:.6g} rad"
-            )
+        y_init = check_initial_state(initial_state, system.critical_angle)
     p = system.to_parameter_vector()
     n = ax.size
     hist = np.empty((K.N_HIST, n))  # one contiguous row per history
@@ -234,16 +253,22 @@ def _summary_dict(summary: np.ndarray, system: ShipBlockSystem) -> dict:
 CASE_COLUMNS = ("record index", "system index", "horizontal scale", "vertical scale")
 
 
-def _case_columns(cases, n_records, n_systems):
+def _case_columns(cases, packed: RecordSet, n_systems: int):
     """Check a cases table and split it into the kernel's contiguous columns.
 
-    Every entry must be finite and the two indices whole numbers within range: a fractional
+    Every entry must be finite, the two indices whole numbers within range (a fractional
     index would otherwise be truncated to another record, and a NaN scale would run as a
-    record at rest (NaN compares false with every threshold).
+    record at rest: NaN compares false with every threshold), and each scaled record within
+    the plausibility limit :data:`shipblock.checks.MAX_ACCELERATION`.
     """
-    table = np.asarray(cases, dtype=float)
+    n_records = len(packed)
+    table = checks.as_real_array(cases, "cases", "an array of rows (record, system, scale_h, "
+                                                 "scale_v)")
+    if table.size == 0 and table.ndim <= 2:
+        table = table.reshape(0, 4)
     if table.ndim != 2 or table.shape[1] != 4:
-        raise ParameterError("cases must have shape (n_cases, 4): record, system, scale_h, scale_v")
+        raise ParameterError("cases must have shape (n_cases, 4): record, system, scale_h, "
+                             f"scale_v; got shape {table.shape}")
     columns = table.T.copy()  # one contiguous row per column
     if not np.isfinite(columns).all():
         col, row = np.argwhere(~np.isfinite(columns))[0]
@@ -262,8 +287,17 @@ def _case_columns(cases, n_records, n_systems):
                 if bad.any():
                     row = int(np.argmax(bad))
                     raise ParameterError(
-                        f"a case refers to a {what} index out of range: cases[{row}, {col}] is "
-                        f"{idx[col, row]}, with {n} {what}{'s' if n != 1 else ''}")
+                        f"cases[{row}, {col}] ({what} index) is {idx[col, row]}: out of range, "
+                        f"with {n} {what}{'s' if n != 1 else ''}")
+        limit = checks.MAX_ACCELERATION * (1.0 + 1e-12)  # a record scaled to exactly 100 g runs
+        for col, peaks, what in ((2, packed.peak_h, "horizontal"), (3, packed.peak_v, "vertical")):
+            scaled = np.abs(columns[col]) * peaks[idx[0]]
+            if not (scaled <= limit).all():
+                row = int(np.argmax(~(scaled <= limit)))
+                raise ParameterError(
+                    f"cases[{row}, {col}] ({CASE_COLUMNS[col]}) is {float(columns[col, row])!r}: it takes "
+                    f"the {what} of records[{idx[0, row]}] to a peak of {scaled[row]:.6g} m/s^2, "
+                    f"above the plausibility limit {checks.MAX_ACCELERATION:g} m/s^2 (100 g)")
     return idx[0], idx[1], columns[2], columns[3]
 
 
@@ -295,7 +329,9 @@ def simulate_batch(
         with a :class:`RecordSet` (which holds its own).
     cases : array_like, shape (n_cases, 4)
         Rows ``(record_index, system_index, scale_h, scale_v)``: finite, the indices whole
-        numbers within range (``CASE_COLUMNS`` names the columns in the errors).
+        numbers within range (``CASE_COLUMNS`` names the columns in the errors), each scaled
+        record within :data:`shipblock.checks.MAX_ACCELERATION` (100 g). No rows: empty
+        results.
     rtol, atol, zeno_omega : float, optional
         As for :func:`simulate`.
 
@@ -304,11 +340,31 @@ def simulate_batch(
     dict of ndarray
         One array of length ``n_cases`` per summary field (see ``SUMMARY_FIELDS``,
         ``MODE_TIME_FIELDS`` and ``peak_rotation_ratio``).
+
+    Raises
+    ------
+    ParameterTypeError
+        For an argument of the wrong type: ``systems`` not systems, a record that is not an
+        ``(ax, ay)`` pair, ``cases`` not numbers.
+    ParameterError
+        For no systems or no records, a bad record (see :class:`RecordSet`), a case that is not
+        finite, refers to a record or system out of range, or scales a record above 100 g, or a
+        tolerance out of range (see :func:`simulate`). Both are :class:`ValueError`; the message
+        names the argument, and the record or case.
     """
     if isinstance(systems, ShipBlockSystem):
         systems = [systems]
+    if isinstance(systems, str | bytes) or not isinstance(systems, Sequence):
+        raise ParameterTypeError(f"systems must be a ShipBlockSystem or a sequence of them, got "
+                                 f"{type(systems).__name__}")
+    if not systems:
+        raise ParameterError("systems must hold at least one ShipBlockSystem")
+    for i, s in enumerate(systems):
+        if not isinstance(s, ShipBlockSystem):
+            raise ParameterTypeError(f"systems[{i}] must be a ShipBlockSystem, got "
+                                     f"{type(s).__name__}")
     params = np.array([s.to_parameter_vector() for s in systems])
-    check_options(rtol, atol, zeno_omega)
+    rtol, atol, zeno_omega = check_options(rtol, atol, zeno_omega)
     if isinstance(records, RecordSet):
         if dts is not None:
             raise ParameterError("dts must not be given with a RecordSet: it holds the records' own")
@@ -319,7 +375,10 @@ def simulate_batch(
         packed = RecordSet(records, dts)
     if cases is None:
         raise ParameterError("cases is required: rows (record, system, scale_h, scale_v)")
-    rec_idx, par_idx, scale_h, scale_v = _case_columns(cases, len(packed), len(params))
+    rec_idx, par_idx, scale_h, scale_v = _case_columns(cases, packed, len(params))
+    if rec_idx.size == 0:
+        return {name: np.zeros(0) for name in (*SUMMARY_FIELDS, *MODE_TIME_FIELDS,
+                                                "peak_rotation_ratio")}
     summaries = np.empty((rec_idx.size, K.N_SUMMARY))
     K.run_many(
         params,

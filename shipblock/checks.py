@@ -1,0 +1,264 @@
+"""Checks of arguments where they enter shipblock, and the plausibility limits they apply.
+
+Every public function checks its arguments with these helpers before any work, so that a wrong
+value ends in a :class:`~shipblock.errors.ParameterError` that names the argument and says what
+it expects (a :class:`~shipblock.errors.ParameterTypeError`, also a :class:`TypeError`, for a
+value of the wrong type), never in a numba typing error, an ``OverflowError`` deep inside NumPy
+or a NaN result.
+
+Beyond the mathematical domain (a positive mass, a finite number) the inputs are held to
+physical plausibility: a ground acceleration above :data:`MAX_ACCELERATION` (100 g; the largest
+recorded are about 4 g) or a sampling interval outside :data:`MIN_TIME_STEP` ..
+:data:`MAX_TIME_STEP` is a corrupt number or a unit mistake, not a record. The same limits are
+applied by the record readers (:mod:`shipblock.io`), so whatever a reader accepts the solver
+runs.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Collection
+
+import numpy as np
+
+from shipblock.errors import ParameterError, ParameterTypeError
+from shipblock.units import STANDARD_GRAVITY
+
+__all__ = [
+    "MAX_ACCELERATION",
+    "MAX_DURATION",
+    "MAX_PADDING",
+    "MAX_PERIOD",
+    "MAX_TIME_STEP",
+    "MIN_PERIOD",
+    "MIN_TIME_STEP",
+    "acceleration",
+    "choice",
+    "is_real",
+    "real",
+    "time_step",
+    "whole",
+]
+
+#: Largest absolute ground acceleration accepted [m/s^2] (100 g), for records as given and as
+#: scaled.
+MAX_ACCELERATION = 100.0 * STANDARD_GRAVITY
+
+#: Range of sampling intervals accepted [s] (10 kHz to 1 Hz).
+MIN_TIME_STEP = 1e-4
+MAX_TIME_STEP = 1.0
+
+#: Range of oscillator periods of a response spectrum or a scaling measure [s] (a period of 0,
+#: where a spectrum takes one, stands for PGA; below the finest sampling interval the
+#: oscillator is rigid).
+MIN_PERIOD = 1e-4
+MAX_PERIOD = 100.0
+
+#: Longest time a record is trimmed at [s] (a day; no earthquake record is longer).
+MAX_DURATION = 86_400.0
+
+#: Longest zero padding added to either end of a record [s].
+MAX_PADDING = 600.0
+
+_REAL_TYPES = (int, float, np.integer, np.floating)
+
+
+def is_real(value) -> bool:
+    """Whether ``value`` is a real number (a Python or NumPy int or float, not a bool)."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    return isinstance(value, _REAL_TYPES) and not isinstance(value, bool | np.bool_)
+
+
+def _bound(value: float, low, high, low_open: bool, high_open: bool) -> bool:
+    if low is not None and (value <= low if low_open else value < low):
+        return False
+    return not (high is not None and (value >= high if high_open else value > high))
+
+
+def _describe(low, high, low_open: bool, high_open: bool, units: str) -> str:
+    unit = f" [{units}]" if units else ""
+    if low is not None and high is not None:
+        return (f"a number in {'(' if low_open else '['}{low:g}, {high:g}"
+                f"{')' if high_open else ']'}{unit}")
+    if low is not None:
+        return f"a finite number {'>' if low_open else '>='} {low:g}{unit}"
+    if high is not None:
+        return f"a finite number {'<' if high_open else '<='} {high:g}{unit}"
+    return f"a finite number{unit}"
+
+
+def real(value, name: str, *, low=None, high=None, low_open: bool = False,
+         high_open: bool = False, units: str = "") -> float:
+    """``value`` as a float, checked to be a finite number within the given bounds.
+
+    Parameters
+    ----------
+    value : object
+        The argument.
+    name : str
+        Its name, for the message.
+    low, high : float, optional
+        Bounds (inclusive unless ``low_open``/``high_open``).
+    low_open, high_open : bool
+        Whether the bound itself is excluded.
+    units : str
+        Units of the value, for the message.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``value`` is not a real number (a bool, a string, None, a sequence...).
+    ParameterError
+        If it is not finite or out of bounds.
+    """
+    expected = _describe(low, high, low_open, high_open, units)
+    if not is_real(value):
+        raise ParameterTypeError(f"{name} must be {expected}, got {type(value).__name__} "
+                                 f"{value!r}")
+    try:
+        x = float(value)
+    except OverflowError:  # an int beyond the float range
+        x = math.inf
+    if not (math.isfinite(x) and _bound(x, low, high, low_open, high_open)):
+        raise ParameterError(f"{name} must be {expected}, got {value!r}")
+    return x
+
+
+def whole(value, name: str, *, low: int | None = None, high: int | None = None) -> int:
+    """``value`` as an int, checked to be a whole number within ``[low, high]``.
+
+    A float with a whole value (``3.0``) is accepted; a bool is not.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``value`` is not a real number.
+    ParameterError
+        If it is not finite, not whole, or out of bounds.
+    """
+    expected = "a whole number" + ("" if low is None else f" >= {low}") + (
+        "" if high is None else f" and <= {high}")
+    if not is_real(value):
+        raise ParameterTypeError(f"{name} must be {expected}, got {type(value).__name__} "
+                                 f"{value!r}")
+    if isinstance(value, int | np.integer):
+        n = int(value)
+    else:
+        x = float(value)
+        if not (math.isfinite(x) and x == math.floor(x)):
+            raise ParameterError(f"{name} must be {expected}, got {value!r}")
+        n = int(x)
+    if (low is not None and n < low) or (high is not None and n > high):
+        raise ParameterError(f"{name} must be {expected}, got {value!r}")
+    return n
+
+
+def choice(value, name: str, choices: Collection[str]) -> str:
+    """``value`` checked to be one of the strings ``choices``.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``value`` is not a string.
+    ParameterError
+        If it is not one of ``choices``.
+    """
+    listed = ", ".join(repr(c) for c in choices)
+    if not isinstance(value, str):
+        raise ParameterTypeError(f"{name} must be one of {listed}, got {type(value).__name__} "
+                                 f"{value!r}")
+    if value not in choices:
+        raise ParameterError(f"{name} must be one of {listed}, got {value!r}")
+    return value
+
+
+def time_step(dt, name: str = "dt") -> float:
+    """A sampling interval, checked to lie in [:data:`MIN_TIME_STEP`, :data:`MAX_TIME_STEP`] [s].
+
+    Raises
+    ------
+    ParameterTypeError, ParameterError
+        Naming ``name``.
+    """
+    # a relative slack of 1e-9: an interval computed as 1 / 10 kHz may round below 1e-4
+    return real(dt, name, low=MIN_TIME_STEP * (1.0 - 1e-9), high=MAX_TIME_STEP * (1.0 + 1e-9),
+                units="s")
+
+
+def acceleration(values, name: str, *, limit: float = MAX_ACCELERATION,
+                 min_samples: int = 2) -> np.ndarray:
+    """A ground acceleration as a contiguous float array, checked sample by sample.
+
+    Parameters
+    ----------
+    values : array_like
+        The samples [m/s^2].
+    name : str
+        The argument's name, for the message.
+    limit : float
+        Largest absolute sample accepted [m/s^2]; :data:`MAX_ACCELERATION` by default.
+    min_samples : int
+        Fewest samples accepted.
+
+    Returns
+    -------
+    numpy.ndarray
+        One-dimensional, float64, C-contiguous.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``values`` is not an array of real numbers.
+    ParameterError
+        If it is not one-dimensional, is too short, or holds a non-finite sample or one above
+        ``limit`` (the message gives the first such sample).
+    """
+    arr = as_real_array(values, name, "a one-dimensional array of accelerations [m/s^2]")
+    if arr.ndim != 1:
+        raise ParameterError(f"{name} must be a one-dimensional (1-D) array, got shape "
+                             f"{arr.shape}")
+    if arr.size < min_samples:
+        raise ParameterError(f"{name} must have at least {min_samples} samples, got {arr.size}")
+    check_samples(arr, name, limit)
+    return np.ascontiguousarray(arr)
+
+
+def as_real_array(values, name: str, what: str, kinds: str = "iuf") -> np.ndarray:
+    """``values`` as a float64 array, or a :class:`ParameterTypeError` naming ``name``.
+
+    ``kinds`` are the NumPy dtype kinds accepted (``"b"`` added for true/false arrays).
+    """
+    if type(values) is np.ndarray and values.dtype == np.float64:
+        return values  # the common case, at no cost
+    if values is None or isinstance(values, str | bytes | dict | set):
+        raise ParameterTypeError(f"{name} must be {what}, got {type(values).__name__}")
+    try:
+        arr = np.asarray(values)
+        if arr.dtype.kind not in kinds:
+            raise TypeError(f"elements of type {arr.dtype}")
+        return arr.astype(np.float64, copy=False)
+    except (TypeError, ValueError) as exc:
+        raise ParameterTypeError(f"{name} must be {what}, got {type(values).__name__} "
+                                 f"({exc})") from None
+
+
+def check_samples(arr: np.ndarray, name: str, limit: float = MAX_ACCELERATION) -> None:
+    """Raise a :class:`ParameterError` naming the first non-finite sample or one above ``limit``.
+
+    One pass over the samples (NaN fails the comparison, so it is found too).
+    """
+    if arr.size and arr.max() <= limit and arr.min() >= -limit:
+        return
+    bad = ~(np.abs(arr) <= limit)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        what = "non-finite" if not np.isfinite(arr[i]) else f"above {limit / STANDARD_GRAVITY:g} g"
+        raise ParameterError(
+            f"{name} has {int(bad.sum())} sample(s) that are NaN, infinite or above the "
+            f"plausibility limit {limit:g} m/s^2 ({limit / STANDARD_GRAVITY:g} g); the first is "
+            f"{float(arr[i])!r} at index {i} ({what})")
