@@ -198,16 +198,6 @@ def test_whole_float_n_blocks_is_kept_as_an_int():
     assert system.n_blocks == 120 and isinstance(system.n_blocks, int)
 
 
-def test_solver_limits_equal_the_readers_limits():
-    """What a reader accepts the solver runs: the same plausibility limits."""
-    from shipblock import checks
-    from shipblock.io import _common
-
-    assert checks.MAX_ACCELERATION == _common.MAX_ACCELERATION_SI
-    assert checks.MIN_TIME_STEP == _common.MIN_SAMPLING_INTERVAL_S
-    assert checks.MAX_TIME_STEP == _common.MAX_SAMPLING_INTERVAL_S
-
-
 @pytest.mark.parametrize("case", list(CASES))
 def test_bad_input_raises_a_named_shipblock_error(case):
     make, named = CASES[case]

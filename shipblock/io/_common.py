@@ -15,6 +15,7 @@ import re
 import numpy as np
 from obspy import Trace, UTCDateTime
 
+from shipblock.checks import MAX_ACCELERATION, MAX_TIME_STEP, MIN_TIME_STEP
 from shipblock.errors import RecordError, UnitsError
 from shipblock.units import ACCELERATION_UNITS_TO_SI, VELOCITY_UNITS_TO_SI
 
@@ -25,13 +26,11 @@ PEEK_BYTES = 8192
 #: text parser (the largest real accelerogram text files are a few tens of MB).
 MAX_TEXT_BYTES = 512 * 1024 * 1024
 
-#: Largest absolute acceleration accepted as a ground motion [m/s^2] (100 g; the largest recorded
-#: ground accelerations are about 4 g): anything above is a corrupt number, not a record.
-MAX_ACCELERATION_SI = 980.665
-
-#: Range of sampling intervals accepted [s] (10 kHz to 1 Hz); outside it the header is corrupt.
-MIN_SAMPLING_INTERVAL_S = 1e-4
-MAX_SAMPLING_INTERVAL_S = 1.0
+# The plausibility limits are the solver's (one home, :mod:`shipblock.checks`), so that whatever a
+# reader accepts the solver runs: 100 g, and sampling intervals of 1e-4..1 s.
+MAX_ACCELERATION_SI = MAX_ACCELERATION
+MIN_SAMPLING_INTERVAL_S = MIN_TIME_STEP
+MAX_SAMPLING_INTERVAL_S = MAX_TIME_STEP
 
 #: Range of times a record may start in (UTC). The oldest strong-motion records are of 1933 (Long
 #: Beach); files that state no start time are put at the epoch, 1970. A start outside comes from a
