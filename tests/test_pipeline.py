@@ -22,7 +22,13 @@ import xarray as xr
 import shipblock
 from shipblock import simulate
 from shipblock.catalogue import load_catalogue
-from shipblock.fragility.pipeline import PipelineError, load_pipeline, run_pipeline
+from shipblock.fragility.fit import fit_ida
+from shipblock.fragility.pipeline import (
+    PipelineError,
+    fragility_variables,
+    load_pipeline,
+    run_pipeline,
+)
 from shipblock.units import STANDARD_GRAVITY as G
 
 from .test_batch import make_catalogue
@@ -77,6 +83,9 @@ chunk_size = {chunk_size}
 """
 
 
+IDA_LEVELS_G = (0.2, 0.3, 0.4, 0.45, 0.5)
+
+
 def write_pipeline(tmp_path, *, ids='"all"', kind="ida", sweep="", chunk_size=4,
                    levels='levels_g = [0.2, 0.4, 0.5, 0.6, 0.8]', n_records=3, bad=False,
                    name="p.toml") -> Path:
@@ -99,7 +108,9 @@ def assert_same_results(a: xr.Dataset, b: xr.Dataset):
 @pytest.fixture(scope="module")
 def ida_run(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("ida")
-    path = write_pipeline(tmp)
+    # levels fine enough around the three records' capacities for the interval-censored fit
+    # to identify beta (their intervals do not all share a point)
+    path = write_pipeline(tmp, levels=f"levels_g = {list(IDA_LEVELS_G)}")
     ds = run_pipeline(path, progress=False)
     return tmp, path, ds
 
@@ -115,7 +126,7 @@ def test_ida_dataset_layout_and_fits(ida_run):
     assert not (tmp / "out" / "result.nc.partial").exists()  # removed after the final write
     assert ds.sizes == {"record": 3, "im_level": 5, "limit_state": 2}
     assert list(ds["record"].values) == ["syn/S0", "syn/S1", "syn/S2"]
-    np.testing.assert_allclose(ds["im_level"], np.array([0.2, 0.4, 0.5, 0.6, 0.8]) * G)
+    np.testing.assert_allclose(ds["im_level"], np.array(IDA_LEVELS_G) * G)
     assert ds["peak_ship_slip"].dims == ("record", "im_level")
     assert ds["exceeded"].dims == ("limit_state", "record", "im_level")
     # achieved IM equals the target level for every record
@@ -124,7 +135,7 @@ def test_ida_dataset_layout_and_fits(ida_run):
     # fitted median per limit state, in m/s^2, inside the analysed range
     median = ds["median"].sel(limit_state="ship_slip")
     assert ds["median"].attrs["units"] == "m/s^2"
-    assert 0.2 * G < float(median) < 0.8 * G
+    assert 0.2 * G < float(median) < 0.5 * G
     assert float(ds["beta"].sel(limit_state="ship_slip")) > 0
     # exceedance is consistent with the EDP and threshold
     expect = (ds["peak_ship_slip"] > 0.005) | (ds["failure"] != 0)
@@ -135,6 +146,39 @@ def test_ida_dataset_layout_and_fits(ida_run):
     assert '"step": "taper"' in ds.attrs["processing_chain"]
     assert "syn/S1" in ds.attrs["records_provenance"]
     assert '"ship_mass": 5000000.0' in ds.attrs["system"]
+    # IDA fitted on the capacity intervals (last level held, first failed] by default
+    assert str(ds["fit_method"].sel(limit_state="ship_slip").values) == "ida_interval"
+    lower = ds["ida_capacity_lower"].sel(limit_state="ship_slip")
+    upper = ds["ida_capacity"].sel(limit_state="ship_slip")
+    assert bool((lower < upper).all())
+    for rec in ds["record"].values:
+        ex = ds["exceeded"].sel(limit_state="ship_slip", record=rec).values
+        levels = ds["im_level"].values
+        first = levels[np.argmax(ex)] if ex.any() else np.inf
+        held = levels[:np.argmax(ex)] if ex.any() else levels
+        assert float(upper.sel(record=rec)) == first
+        assert float(lower.sel(record=rec)) == (held[-1] if held.size else 0.0)
+
+
+def test_first_exceedance_option_reproduces_the_old_estimate_and_old_names_are_refused(
+        ida_run):
+    tmp, path, ds = ida_run
+    text = path.read_text()
+    path = tmp / "first_exceedance.toml"
+    path.write_text(text.replace("[fit]", '[fit]\nida_method = "mle"'))
+    with pytest.raises(PipelineError, match="now named 'first_exceedance'") as info:
+        load_pipeline(path)
+    assert info.value.key == "fit.ida_method"
+    path.write_text(text.replace("[fit]", '[fit]\nida_method = "first_exceedance"'))
+    pipe = load_pipeline(path)
+    assert pipe.fit["ida_method"] == "first_exceedance"
+    # the option fits the first exceeding levels as capacities, right-censored at the top
+    out = fragility_variables(ds, pipe.design, pipe.limit_states, {**pipe.fit, "bootstrap": 0})
+    upper = ds["ida_capacity"].sel(limit_state="ship_slip").values
+    old = fit_ida(upper, censored_at=ds["im_level"].values[-1])
+    assert float(out["median"].values[0]) == old.median  # limit state 0 is ship_slip
+    assert str(out["fit_method"].values[0]) == "ida_first_exceedance"
+    assert old.median > float(ds["median"].sel(limit_state="ship_slip"))
 
 
 def test_runs_equal_single_simulate(ida_run):

@@ -51,7 +51,9 @@ Schema (``schema_version = 1``; units in brackets, paths relative to the pipelin
     bootstrap = 200                     # resamples over records (0: no bounds)
     confidence = 0.9
     seed = 1
-    ida_method = "mle"                  # or "moments"
+    ida_method = "interval"             # capacity between the last level held and the first
+                                        # failed (default); or "first_exceedance" (the first
+                                        # failed level, biased high), "first_exceedance_moments"
 
     [solver]
     rtol = 1e-8
@@ -114,10 +116,11 @@ from shipblock.fragility.design import (
     IntensityDesign,
 )
 from shipblock.fragility.fit import (
+    IDA_METHODS,
     FragilityFitError,
     bootstrap,
     fit_cloud,
-    fit_ida,
+    fit_ida_levels,
     fit_msa,
     ida_capacities,
 )
@@ -670,15 +673,23 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
         "bootstrap": f.get("bootstrap", DEFAULT_BOOTSTRAP),
         "confidence": float(f.get("confidence", DEFAULT_CONFIDENCE)),
         "seed": f.get("seed", DEFAULT_SEED),
-        "ida_method": f.get("ida_method", "mle"),
+        "ida_method": f.get("ida_method", "interval"),
         "cloud_method": cloud_method,
     }
     if fit["bootstrap"] < 0:
         raise PipelineError("fit.bootstrap", "must be >= 0", source)
     if not 0 < fit["confidence"] < 1:
         raise PipelineError("fit.confidence", "must lie in (0, 1)", source)
-    if fit["ida_method"] not in ("mle", "moments"):
-        raise PipelineError("fit.ida_method", "must be 'mle' or 'moments'", source)
+    if fit["ida_method"] in ("mle", "moments"):
+        old = "first_exceedance" + ("_moments" if fit["ida_method"] == "moments" else "")
+        raise PipelineError("fit.ida_method", f"{fit['ida_method']!r} took the first exceeding "
+                            f"level as the capacity; that estimate is now named {old!r} (it "
+                            "overestimates the median by up to one level step); the default "
+                            "'interval' fits the capacity between the last level that held and "
+                            "the first that failed", source)
+    if fit["ida_method"] not in IDA_METHODS:
+        raise PipelineError("fit.ida_method", f"must be one of {', '.join(map(repr, IDA_METHODS))}"
+                            f", got {fit['ida_method']!r}", source)
     s = doc.get("solver", {})
     solver = {"rtol": float(s.get("rtol", DEFAULT_RTOL)),
               "atol": float(s.get("atol", DEFAULT_ATOL)),
@@ -772,10 +783,9 @@ def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng):
     n_boot = fit_opts["bootstrap"]
     try:
         if kind == "ida":
-            caps = ida_capacities(e[keep], levels, w[keep])
-            capacity = caps
-            args = {"capacities": caps.capacity, "censored_at": caps.censored_at}
-            fn, kw = fit_ida, {"method": fit_opts["ida_method"]}
+            capacity = ida_capacities(e[keep], levels, w[keep])
+            args = {"exceeded": e[keep], "valid": w[keep]}
+            fn, kw = fit_ida_levels, {"im_levels": levels, "method": fit_opts["ida_method"]}
         elif kind == "msa":
             args = {"exceeded": e[keep], "valid": w[keep]}
             fn, kw = fit_msa, {"im_levels": levels}
@@ -826,7 +836,8 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
         Name -> :class:`xarray.DataArray` with ``units`` and ``long_name``: ``exceeded`` and
         ``valid`` on ``(limit_state, *design.dims)``; ``median``, ``beta``, their bounds,
         ``fit_method``, ``fit_error``, ``n_fit_records``, ``bootstrap_failed`` on
-        ``(limit_state, *sweep)``; ``ida_capacity`` on ``(limit_state, record, *sweep)`` for
+        ``(limit_state, *sweep)``; ``ida_capacity`` and ``ida_capacity_lower`` (the first
+        level that failed and the last that held) on ``(limit_state, record, *sweep)`` for
         IDA. Bootstrap resampling of combination ``c`` of limit state ``i`` is seeded with
         ``[seed, i, c]``.
     """
@@ -845,6 +856,7 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
     fields["fit_method"] = np.full((n_ls, *sweep_shape), "", dtype=object)
     fields["fit_error"] = np.full((n_ls, *sweep_shape), "", dtype=object)
     capacity = np.full((n_ls, len(design.records), *sweep_shape), np.nan)
+    capacity_held = capacity.copy()
     im = ds["achieved_im"].values if not intensity.scaled else None
     for i, ls in enumerate(limit_states):
         e_all = ex[ls.name].exceeded.transpose(*design.dims).values
@@ -863,6 +875,9 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
                 col = np.full(len(design.records), np.nan)
                 col[keep] = caps.capacity
                 capacity[(i, slice(None), *combo)] = col
+                col = np.full(len(design.records), np.nan)
+                col[keep] = caps.held
+                capacity_held[(i, slice(None), *combo)] = col
     im_units = intensity.units
     dims_fit = ("limit_state", *sweep_dims)
     info = {
@@ -896,8 +911,13 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
     if kind == "ida":
         out["ida_capacity"] = xr.DataArray(
             capacity, dims=("limit_state", "record", *sweep_dims),
-            attrs={"units": im_units, "long_name": "IDA capacity: first IM level exceeding the "
-                   "limit state (inf: never; NaN: no valid run)"})
+            attrs={"units": im_units, "long_name": "IDA capacity, upper bound: first IM level "
+                   "exceeding the limit state (inf: never; NaN: no valid run)"})
+        out["ida_capacity_lower"] = xr.DataArray(
+            capacity_held, dims=("limit_state", "record", *sweep_dims),
+            attrs={"units": im_units, "long_name": "IDA capacity, lower bound: last IM level "
+                   "that held below the first exceedance (0: exceeded at the first level; NaN: "
+                   "no valid run)"})
     return out
 
 
