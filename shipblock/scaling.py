@@ -157,11 +157,11 @@ def measure_value(acc, dt, measure="pga", period=None, damping=intensity.DEFAULT
     """
     period, damping = _check_measure(measure, period, damping)
     if measure == "pga":
-        return intensity.pga(acc, dt).value
+        return intensity.pga(acc, dt)
     if measure == "pgv":
-        return intensity.pgv(acc, dt).value
+        return intensity.pgv(acc, dt)
     if measure == "pgd":
-        return intensity.pgd(acc, dt).value
+        return intensity.pgd(acc, dt)
     if measure == "sa":
         return intensity.spectral_acceleration(acc, dt, period, damping)
     if measure == "cav":
