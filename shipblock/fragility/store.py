@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import secrets
 import shutil
 import tempfile
 import zipfile
@@ -31,6 +32,7 @@ import xarray as xr
 
 from shipblock.errors import ShipblockError
 from shipblock.fragility.limit_states import EDP_VARIABLES
+from shipblock.modes import MODE_DESCRIPTIONS, MODE_FLAGS
 from shipblock.solver import MODE_TIME_FIELDS, SUMMARY_FIELDS
 
 __all__ = [
@@ -74,7 +76,12 @@ def _run_variables() -> dict[str, tuple[str, str]]:
         elif name in extra:
             out[name] = extra[name]
         elif name.startswith("time_in_mode_"):
-            out[name] = ("s", f"time spent in mode {name.rsplit('_', 1)[1]}")
+            mode = int(name.rsplit("_", 1)[1])
+            flags = ", ".join(f"{what} {state[bit]}" for what, state, bit in zip(
+                ("blocks on ground", "blocks", "ship on blocks"),
+                (("stick", "slide"), ("at rest", "rocking"), ("stick", "slide")),
+                MODE_FLAGS[mode], strict=True))
+            out[name] = ("s", f"time spent in mode {mode}: {MODE_DESCRIPTIONS[mode]} ({flags})")
         else:  # a summary field added to the solver later
             out[name] = ("1", name.replace("_", " "))
     return out
@@ -287,12 +294,30 @@ def _encoding(ds: xr.Dataset) -> dict:
     return enc
 
 
+def _new_file(path: Path) -> str:
+    """Create an empty temporary file next to ``path`` with the permissions of a new file.
+
+    ``tempfile.mkstemp`` creates its files 0600 whatever the umask, and the rename keeps them:
+    result files unreadable to the rest of a team. Here the file is created exclusively with
+    mode 0666, which the umask reduces as for any new file (0644 under the usual 022).
+    """
+    for _ in range(100):
+        tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
+        try:
+            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+        except FileExistsError:
+            continue
+        return str(tmp)
+    raise StoreError(f"cannot create a temporary file next to {path}")
+
+
 def write_dataset(ds: xr.Dataset, path) -> Path:
     """Write a result dataset to NetCDF-4 atomically.
 
     The file is written with the ``netcdf4`` engine and zlib compression of every numeric
     variable to a temporary file next to ``path``, then renamed over ``path``: a reader (or a
-    crash) never sees a half-written file.
+    crash) never sees a half-written file. It gets the permissions of any new file (0666 less
+    the umask: 0644 under the usual umask 022).
 
     Parameters
     ----------
@@ -309,8 +334,7 @@ def write_dataset(ds: xr.Dataset, path) -> Path:
     check_metadata(ds)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
+    tmp = _new_file(path)
     try:
         ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=_encoding(ds))
         os.replace(tmp, path)
