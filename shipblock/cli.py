@@ -436,28 +436,10 @@ def cmd_run(args):
                       progress=not args.quiet)
     out = sys.stdout
     out.write(f"results written to {ds.encoding.get('source', args.output or 'the pipeline output')}\n")
-    if "median" in ds:
-        from shipblock.plot import _im_axis
+    from shipblock.fragility.report import study_report
 
-        out.write("fitted fragility (lognormal):\n")
-        for ls in ds["limit_state"].values:
-            med = ds["median"].sel(limit_state=ls)
-            beta = ds["beta"].sel(limit_state=ls)
-            error = str(ds["fit_error"].sel(limit_state=ls).values) if "fit_error" in ds else ""
-            if med.ndim == 0 and error:
-                # e.g. too few exceedances to identify beta: say why instead of printing nan
-                out.write(f"  {str(ls):<24} not fitted: {error.split(': ', 1)[-1]}\n")
-            elif med.ndim == 0:
-                value, label, _ = _im_axis(ds, [float(med)])
-                band = ""
-                if "median_lower" in ds:
-                    lo, _, _ = _im_axis(ds, [float(ds["median_lower"].sel(limit_state=ls))])
-                    hi, _, _ = _im_axis(ds, [float(ds["median_upper"].sel(limit_state=ls))])
-                    band = f" ({lo[0]:.3g} to {hi[0]:.3g})"
-                out.write(f"  {str(ls):<24} median {label} {value[0]:.3g}{band}, "
-                          f"beta {float(beta):.3f}\n")
-            else:
-                out.write(f"  {str(ls):<24} fitted per swept parameter (see the NetCDF)\n")
+    for line in study_report(ds):
+        out.write(line + "\n")
     if "history_file" in ds:
         n = int((ds["history_file"] != "").sum())
         folder = Path(ds.encoding.get("source", ".")).parent / ds.attrs["histories_directory"]

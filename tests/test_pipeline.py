@@ -238,6 +238,68 @@ def test_sweep_msa_and_error_record(tmp_path):
     slip = ds["peak_ship_slip"].sel(record="syn/S0", slenderness=0.4)
     assert (slip.sel(mu_ship=0.3) >= slip.sel(mu_ship=0.45)).all()
     assert set(ds["fit_method"].sel(limit_state="ship_slip").values.ravel()) <= {"mle", ""}
+    # the study says how many records it used, and why one was left out
+    assert ds.attrs["n_records_used"] == 3
+    assert ds.attrs["records_used"].startswith("3 of 4 records used, 1 left out: syn/BAD "
+                                               "(RecordError: ")
+    np.testing.assert_array_equal(ds["record_used"], [True, True, True, False])
+
+
+def test_strict_study_fails_instead_of_leaving_a_record_out(tmp_path):
+    path = write_pipeline(tmp_path, bad=True)
+    path.write_text(path.read_text().replace('horizontal = "H1"',
+                                             'horizontal = "H1"\nstrict = true'))
+    with pytest.raises(PipelineError, match=r"syn/BAD \(RecordError: ") as info:
+        run_pipeline(path, progress=False)
+    assert info.value.key == "records.strict"
+    assert not (tmp_path / "out").exists()  # failed before any run
+
+
+def test_runs_above_the_scale_factor_limit_are_reported_or_refused(ida_run, tmp_path, caplog):
+    """max_scale_factor = 2.5 on the synthetic records (factors 1.3 to 3.7 over the levels):
+    'warn' runs them and says so; 'refuse' does not make them (NaN, run_error says why), the
+    other runs equal the warned study's bit for bit and the fit counts only them."""
+    tmp, path, full = ida_run
+    text = path.read_text()
+    factors = np.abs(full["scale_factor"].values)
+    expect = factors > 2.5
+    assert expect.any() and not expect.all()
+    out = {}
+    for policy in ("warn", "refuse"):
+        p = tmp / f"{policy}.toml"
+        p.write_text(text.replace('type = "ida"', f'type = "ida"\nmax_scale_factor = 2.5\n'
+                                                  f'scale_factor_policy = "{policy}"'))
+        caplog.clear()
+        out[policy] = run_pipeline(p, output=tmp_path / f"{policy}.nc", progress=False)
+        assert f"{int(expect.sum())} of 15 runs have a scale factor above max_scale_factor = " \
+               "2.5" in caplog.text
+        np.testing.assert_array_equal(out[policy]["scale_factor_above_limit"], expect)
+        assert out[policy].attrs["max_scale_factor"] == 2.5
+        assert out[policy].attrs["scale_factor_policy"] == policy
+    warn, refuse = out["warn"], out["refuse"]
+    np.testing.assert_array_equal(warn["peak_ship_slip"], full["peak_ship_slip"])
+    made = refuse["peak_ship_slip"].values
+    np.testing.assert_array_equal(made[~expect], full["peak_ship_slip"].values[~expect])
+    assert np.isnan(made[expect]).all()
+    errors = refuse["run_error"].values
+    assert all(e.startswith("not run: scale factor ") and e.endswith(
+        "above max_scale_factor 2.5") for e in errors[expect])
+    assert not any(errors[~expect])
+    assert not refuse["valid"].values[:, expect].any()
+    assert refuse.attrs["records_used"] == "3 of 3 records used"
+
+
+def test_fits_and_levels_are_also_kept_in_the_pipelines_units(ida_run):
+    """levels_g: the levels and medians are stored in g beside SI, and fit messages quote
+    the levels in g (no SI number beside a g level)."""
+    _, _, ds = ida_run
+    np.testing.assert_allclose(ds["im_level_g"], IDA_LEVELS_G, rtol=1e-15)
+    assert ds.attrs["im_display_units"] == "g"
+    for name in ("median", "median_lower", "median_upper"):
+        assert ds[f"{name}_g"].attrs["units"] == "g"
+        np.testing.assert_allclose(ds[f"{name}_g"], ds[name] / G, rtol=1e-15)
+    error = str(ds["fit_error"].sel(limit_state="any_failure").values)
+    assert error.endswith("highest level (0.5); analyse higher IM levels [IM in g]")
 
 
 def test_msa_with_a_record_set_per_stripe(tmp_path):

@@ -20,6 +20,7 @@ Schema (``schema_version = 1``; units in brackets, paths relative to the pipelin
     azimuth = 0.0                       # dock transverse axis [deg from north], or
     horizontal = "H1"                   # one horizontal as recorded (default "H1")
     response = "sensitivity"            # or "full" (instrument response removal)
+    strict = false                      # true: fail if a record is left out or a run refused
 
     [[processing]]                      # optional; absent: shipblock.processing.DEFAULT_CHAIN
     step = "demean"                     # processing = [] for no processing
@@ -40,6 +41,8 @@ Schema (``schema_version = 1``; units in brackets, paths relative to the pipelin
                                         # "unscaled" or "zero"
     stripes = [["NP.1737", "NP.1743"], ["NP.1759", "NP.1765"], ...]
                                         # msa only, optional: the records of each level
+    max_scale_factor = 5.0              # warn about runs scaled by more (default 5) [-]
+    scale_factor_policy = "warn"        # or "refuse": runs scaled by more are not made
     cloud_method = "probit"             # cloud only: "probit" or "regression"
 
     [[limit_states]]                    # see shipblock.fragility.limit_states
@@ -163,6 +166,11 @@ SCHEMA_VERSION = 1
 #: Default largest number of time-history files of a pipeline's [histories] request.
 DEFAULT_MAX_HISTORIES = 100
 
+#: Default largest scale factor of a run made without a warning [-] (a common practical
+#: ceiling for amplitude scaling; ASCE 7-22 commentary and PEER practice keep factors within
+#: about 0.25 to 4-5).
+DEFAULT_MAX_SCALE_FACTOR = 5.0
+
 #: Defaults of the [fit] table.
 DEFAULT_BOOTSTRAP = 200
 DEFAULT_CONFIDENCE = 0.9
@@ -223,6 +231,7 @@ _SCHEMA: dict[str, dict[str, tuple]] = {
         "azimuth": (_NUM, False),
         "horizontal": ((str,), False),
         "response": ((str,), False),
+        "strict": ((bool,), False),
     },
     "system": {
         **{name: (_NUM, False) for name in SYSTEM_FIELDS if name != "impact_rule"},
@@ -243,6 +252,8 @@ _SCHEMA: dict[str, dict[str, tuple]] = {
         "vertical_levels_g": ((list,), False),
         "cloud_method": ((str,), False),
         "stripes": ((list,), False),
+        "max_scale_factor": (_NUM, False),
+        "scale_factor_policy": ((str,), False),
     },
     "fit": {
         "bootstrap": ((int,), False),
@@ -428,6 +439,17 @@ class Pipeline:
         Output file (absolute).
     histories : HistoryRequest or None
         Runs whose full time histories are written; None for none.
+    max_scale_factor : float
+        Largest scale factor [-] a run is made with silently (``design.max_scale_factor``).
+    scale_factor_policy : str
+        ``"warn"`` (run and report) or ``"refuse"`` (do not make) a run scaled by more.
+    strict : bool
+        Fail, rather than go on without them, when records are left out or runs refused
+        (``records.strict``).
+    im_display : tuple of (str, float)
+        The unit the pipeline gives its IM levels in (``"g"`` for ``levels_g``, else
+        ``design.units``) and its value in SI units: the unit of the messages, of the
+        command's output and of the result's ``*_g`` companions.
     """
 
     source: str
@@ -446,6 +468,10 @@ class Pipeline:
     scheduler: str | None
     output: Path
     histories: HistoryRequest | None = None
+    max_scale_factor: float = DEFAULT_MAX_SCALE_FACTOR
+    scale_factor_policy: str = "warn"
+    strict: bool = False
+    im_display: tuple[str, float] = ("m/s^2", 1.0)
 
     def identity(self) -> dict:
         """The parts of the document that determine the results (no output path, scheduler
@@ -458,8 +484,8 @@ class Pipeline:
         doc = {k: v for k, v in self.document.items()
                if k not in ("output", "title", "description", "histories")}
         doc["execution"] = {"chunk_size": self.chunk_size}
-        doc["records"] = {**doc["records"], "catalogue": str(self.catalogue),
-                          "ids": list(self.design.records)}
+        doc["records"] = {**{k: v for k, v in doc["records"].items() if k != "strict"},
+                          "catalogue": str(self.catalogue), "ids": list(self.design.records)}
         return doc
 
 
@@ -712,8 +738,33 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
         horizontal=horizontal, response=response, chain=chain, design=design,
         limit_states=limit_states, fit=fit, solver=solver, chunk_size=int(chunk_size),
         scheduler=ex.get("scheduler"), output=(base / doc["output"]).resolve(),
-        histories=histories,
+        histories=histories, **_scaling_limits(doc, source),
+        im_display=_im_display(d, measure, source),
     )
+
+
+def _im_display(design: Mapping, measure: str, source: str) -> tuple[str, float]:
+    """The unit the pipeline writes its IM in and its SI value (see ``Pipeline.im_display``)."""
+    if "levels_g" in design or ("units" not in design and measure != "pgv"):
+        return "g", STANDARD_GRAVITY
+    if "units" in design:
+        return design["units"], _im_factor(measure, design["units"], "design.units", source)
+    return "m/s", 1.0
+
+
+def _scaling_limits(doc, source) -> dict:
+    """``max_scale_factor``, ``scale_factor_policy`` ([design]) and ``strict`` ([records])."""
+    d = doc["design"]
+    limit = d.get("max_scale_factor", DEFAULT_MAX_SCALE_FACTOR)
+    if not (math.isfinite(limit) and limit >= 1.0):
+        raise PipelineError("design.max_scale_factor", f"must be a number >= 1, got {limit!r}",
+                            source)
+    policy = d.get("scale_factor_policy", "warn")
+    if policy not in ("warn", "refuse"):
+        raise PipelineError("design.scale_factor_policy",
+                            f"must be 'warn' or 'refuse', got {policy!r}", source)
+    return {"max_scale_factor": float(limit), "scale_factor_policy": policy,
+            "strict": bool(doc["records"].get("strict", False))}
 
 
 def _parse_histories(table, design, limit_states, base, source) -> HistoryRequest:
@@ -782,6 +833,8 @@ def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng):
     capacity = None
     n_boot = fit_opts["bootstrap"]
     try:
+        if not keep.any():
+            raise FragilityFitError("no record has a valid run: nothing to fit")
         if kind == "ida":
             capacity = ida_capacities(e[keep], levels, w[keep])
             args = {"exceeded": e[keep], "valid": w[keep]}
@@ -815,7 +868,8 @@ def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng):
     return out, capacity
 
 
-def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fit_opts) -> dict:
+def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fit_opts,
+                        im_display: tuple[str, float] = ("", 1.0)) -> dict:
     """Exceedance, fitted median/beta and bootstrap bounds of every limit state.
 
     Parameters
@@ -829,6 +883,11 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
         The limit states (the ``limit_state`` dimension).
     fit_opts : dict
         ``bootstrap`` (resamples), ``confidence``, ``seed``, ``ida_method``, ``cloud_method``.
+    im_display : tuple of (str, float)
+        Unit the pipeline writes its IM in and its SI value (:attr:`Pipeline.im_display`): the
+        fits are made in it, so that their messages (``fit_error``) quote the levels as the
+        pipeline wrote them, and with ``"g"`` the medians are stored in g too (``median_g``,
+        ``median_lower_g``, ``median_upper_g``). Default: SI.
 
     Returns
     -------
@@ -843,7 +902,9 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
     """
     intensity = design.intensity
     kind = intensity.kind
-    levels = np.asarray(intensity.levels, dtype=float)
+    unit, factor = im_display
+    unit = unit or intensity.units
+    levels = np.asarray(intensity.levels, dtype=float) / factor  # in the pipeline's unit
     ex = evaluate_limit_states(limit_states, ds)
     names = [ls.name for ls in limit_states]
     sweep_dims = design.sweep_names
@@ -857,7 +918,7 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
     fields["fit_error"] = np.full((n_ls, *sweep_shape), "", dtype=object)
     capacity = np.full((n_ls, len(design.records), *sweep_shape), np.nan)
     capacity_held = capacity.copy()
-    im = ds["achieved_im"].values if not intensity.scaled else None
+    im = ds["achieved_im"].values / factor if not intensity.scaled else None
     for i, ls in enumerate(limit_states):
         e_all = ex[ls.name].exceeded.transpose(*design.dims).values
         w_all = ex[ls.name].valid.transpose(*design.dims).values
@@ -868,15 +929,19 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
             rng = np.random.default_rng([int(fit_opts["seed"]), i, c])
             res, caps = _fit_one(kind, e_all[sel], w_all[sel], levels, im, edp_all[sel], ls,
                                  fit_opts, rng)
+            for k in ("median", "median_lower", "median_upper"):
+                res[k] *= factor  # back to SI
+            if res["fit_error"]:
+                res["fit_error"] += f" [IM in {unit}]"
             for k, v in res.items():
                 fields[k][(i, *combo)] = v
             if caps is not None:
                 keep = w_all[sel].any(axis=1)
                 col = np.full(len(design.records), np.nan)
-                col[keep] = caps.capacity
+                col[keep] = caps.capacity * factor
                 capacity[(i, slice(None), *combo)] = col
                 col = np.full(len(design.records), np.nan)
-                col[keep] = caps.held
+                col[keep] = caps.held * factor
                 capacity_held[(i, slice(None), *combo)] = col
     im_units = intensity.units
     dims_fit = ("limit_state", *sweep_dims)
@@ -900,6 +965,10 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
             attrs["confidence"] = fit_opts["confidence"]
             attrs["n_bootstrap"] = int(fit_opts["bootstrap"])
         out[k] = xr.DataArray(fields[k], dims=dims_fit, attrs=attrs)
+    if unit == "g" and factor == STANDARD_GRAVITY:
+        for k in ("median", "median_lower", "median_upper"):
+            out[f"{k}_g"] = xr.DataArray(fields[k] / factor, dims=dims_fit, attrs={
+                **out[k].attrs, "units": "g", "long_name": out[k].attrs["long_name"] + " in g"})
     dims_run = ("limit_state", *design.dims)
     out["exceeded"] = xr.DataArray(
         np.stack([ex[n].exceeded.transpose(*design.dims).values for n in names]), dims=dims_run,
@@ -969,6 +1038,115 @@ def _fingerprint(pipe: Pipeline, records) -> str:
     return h.hexdigest()
 
 
+def _scale_factors(pipe: Pipeline, records) -> np.ndarray:
+    """|Scale factor| of every (record, level) [-]: the horizontal's, and the vertical's when it
+    is scaled to its own targets; NaN for a record left out."""
+    f = np.array([np.abs(r.factor_h) for r in records], dtype=float)
+    if pipe.design.intensity.vertical == "independent":
+        fv = np.array([np.abs(r.factor_v) for r in records], dtype=float)
+        f = np.fmax(f, fv)
+    return f
+
+
+def _record_use(pipe: Pipeline, records):
+    """Runs scaled beyond the limit, those refused, and the records left out (with reasons).
+
+    Returns ``(above, refused, left_out)``: two (record, level) masks and ``{id: reason}``.
+    Warns about runs above the limit; raises :class:`PipelineError` under ``records.strict``
+    if a record is left out or a run refused.
+    """
+    design = pipe.design
+    factors = _scale_factors(pipe, records)
+    with np.errstate(invalid="ignore"):
+        above = (factors > pipe.max_scale_factor) & design.stripe_mask()
+    if not design.intensity.scaled:
+        above[:] = False
+    refused = above if pipe.scale_factor_policy == "refuse" else np.zeros_like(above)
+    left_out = {}
+    for i, r in enumerate(records):
+        if r.error is not None:
+            left_out[r.id] = r.error
+        elif not (design.stripe_mask()[i] & ~refused[i]).any():
+            f = factors[i][design.stripe_mask()[i]]
+            left_out[r.id] = (f"every run refused: scale factors {f.min():.4g} to {f.max():.4g} "
+                              f"above max_scale_factor {pipe.max_scale_factor:g}")
+    if above.any():
+        worst = np.unravel_index(np.nanargmax(np.where(above, factors, np.nan)), above.shape)
+        what = "not run" if pipe.scale_factor_policy == "refuse" else "run"
+        unit, per_unit = pipe.im_display
+        logger.warning(
+            "%d of %d runs have a scale factor above max_scale_factor = %g (%s; the largest, %.4g, "
+            "is %s at %s %.4g %s)", int(above.sum()), int(design.stripe_mask().sum()),
+            pipe.max_scale_factor, what, factors[worst], design.records[worst[0]],
+            design.intensity.measure.upper(), design.intensity.levels[worst[1]] / per_unit, unit)
+    if pipe.strict and (left_out or refused.any()):
+        why = [f"{rid} ({reason})" for rid, reason in left_out.items()]
+        if refused.any():
+            why.append(f"{int(refused.sum())} runs refused for their scale factor")
+        raise PipelineError("records.strict", "the study would go on without some of its "
+                            f"records or runs: {'; '.join(why)}", pipe.source)
+    for rid, reason in left_out.items():
+        if records[design.records.index(rid)].error is None:  # errors were said when read
+            logger.warning("record %s left out: %s", rid, reason)
+    return above, refused, left_out
+
+
+def records_used_message(n_records: int, left_out: Mapping[str, str]) -> str:
+    """``"7 of 9 records used, 2 left out: A (why); B (why)"``.
+
+    Parameters
+    ----------
+    n_records : int
+        Records named by the study.
+    left_out : mapping
+        Record id -> reason, for the records left out.
+
+    Returns
+    -------
+    str
+    """
+    used = n_records - len(left_out)
+    text = f"{used} of {n_records} records used"
+    if left_out:
+        text += f", {len(left_out)} left out: " + "; ".join(
+            f"{rid} ({reason})" for rid, reason in left_out.items())
+    return text
+
+
+def _add_record_use(ds, pipe: Pipeline, records, above, refused, left_out) -> xr.Dataset:
+    """Scale-factor limit, refused runs and records used, as variables and attributes."""
+    design = pipe.design
+    limit = pipe.max_scale_factor
+    if design.intensity.scaled:
+        ds["scale_factor_above_limit"] = xr.DataArray(
+            above, dims=("record", "im_level"),
+            attrs={"units": "1", "long_name": f"scale factor above max_scale_factor = {limit:g} "
+                   f"(policy {pipe.scale_factor_policy!r}: "
+                   f"{'not run' if pipe.scale_factor_policy == 'refuse' else 'run, reported'})",
+                   "max_scale_factor": limit})
+        if refused.any():
+            factors = _scale_factors(pipe, records)
+            errors = ds["run_error"].transpose(*design.dims).values.copy()
+            for r, j in zip(*np.nonzero(refused), strict=True):
+                errors[r, j, ...] = (f"not run: scale factor {factors[r, j]:.4g} above "
+                                     f"max_scale_factor {limit:g}")
+            ds["run_error"] = ds["run_error"].copy(data=errors)
+    ds["record_used"] = xr.DataArray(
+        np.array([r not in left_out for r in design.records]), dims=("record",),
+        attrs={"units": "1", "long_name": "record used in the study (see record_error or "
+                                          "the attribute records_used for why not)"})
+    for rid, reason in left_out.items():
+        if not ds["record_error"].sel(record=rid).item():
+            ds["record_error"].loc[{"record": rid}] = reason
+    ds.attrs.update({
+        "max_scale_factor": limit,
+        "scale_factor_policy": pipe.scale_factor_policy,
+        "n_records_used": len(design.records) - len(left_out),
+        "records_used": records_used_message(len(design.records), left_out),
+    })
+    return ds
+
+
 def _loader(entry, pipe: Pipeline):
     def load():
         kwargs = {"response": pipe.response}
@@ -1030,6 +1208,7 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         prepare_record(rid, _loader(entries[rid], pipe), pipe.chain, design.intensity)
         for rid in design.records
     ]
+    above, refused, left_out = _record_use(pipe, records)
     fingerprint = _fingerprint(pipe, records)
     store = ChunkStore(out_path.with_name(out_path.name + ".partial"), fingerprint)
     try:
@@ -1046,7 +1225,8 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         client = own_client = Client(scheduler)
     try:
         results = run_batch(design, records, store, chunk_size=pipe.chunk_size, client=client,
-                            progress=progress, solver_options=pipe.solver, timings=timings)
+                            progress=progress, solver_options=pipe.solver, timings=timings,
+                            runs=design.stripe_mask() & ~refused)
     finally:
         if own_client is not None:
             own_client.close()
@@ -1054,7 +1234,11 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     ds = summary_dataset(design, records, results)
     ds = ds.assign_coords({k: xr.Variable(*v) for k, v in _limit_state_coords(
         pipe.limit_states).items()})
-    ds = ds.assign(fragility_variables(ds, design, pipe.limit_states, pipe.fit))
+    ds = ds.assign(fragility_variables(ds, design, pipe.limit_states, pipe.fit,
+                                       im_display=pipe.im_display))
+    if pipe.im_display[0] == "g" and design.intensity.scaled:
+        ds = ds.assign_coords(im_level_g=("im_level", ds["im_level"].values / STANDARD_GRAVITY, {
+            "units": "g", "long_name": ds["im_level"].attrs["long_name"] + " in g"}))
     chain = [dict(e) for e in (DEFAULT_CHAIN if pipe.chain is None else pipe.chain)]
     intensity = design.intensity
     ds.attrs = {
@@ -1069,6 +1253,8 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         "im_units": intensity.units,
         "im_long_name": intensity.long_name,
         "im_damping": intensity.damping,
+        "im_display_units": pipe.im_display[0],
+        "im_display_factor": pipe.im_display[1],
         "vertical_mode": intensity.vertical,
         "component": (f"azimuth {pipe.azimuth:g} deg" if pipe.azimuth is not None
                       else str(pipe.horizontal)),
@@ -1083,6 +1269,7 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     }
     if intensity.period is not None:
         ds.attrs["im_period"] = intensity.period
+    ds = _add_record_use(ds, pipe, records, above, refused, left_out)
     clock.lap("fragility")
     if pipe.histories is not None:
         ds = _add_histories(ds, pipe, records, out_path, fingerprint, progress)
