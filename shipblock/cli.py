@@ -277,7 +277,7 @@ def cmd_history(args):
     name = ds.attrs["record"]
     level = ""
     if "im_level" in ds.attrs:
-        level = f" at {ds.attrs['im_level']:.4g} {ds.attrs['im_units']}"
+        level = f" at {_run_name(ds).rsplit(', ', 1)[-1]}"
     sys.stdout.write(f"run {ds.attrs['case']} of {args.pipeline}: {name}{level}, scale factor "
                      f"{ds.attrs['scale_factor']:.4g}\n")
     _report(res, name, args.events)
@@ -292,7 +292,10 @@ def _run_name(ds):
     name = ds.attrs.get("record", "")
     if name and "im_level" in ds.attrs:
         value, unit = float(ds.attrs["im_level"]), ds.attrs.get("im_units", "")
-        if unit == "m/s^2":
+        if "im_display_units" in ds.attrs:  # the unit the pipeline gave its levels in
+            value /= float(ds.attrs["im_display_factor"])
+            unit = ds.attrs["im_display_units"]
+        elif unit == "m/s^2":
             value, unit = value / STANDARD_GRAVITY, "g"
         measure = ds.attrs.get("im_measure", "IM").upper().replace("SA", "Sa")
         name += f", {measure} {value:.3g} {unit}"

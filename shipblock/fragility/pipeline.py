@@ -1295,7 +1295,8 @@ def _add_histories(ds, pipe: Pipeline, records, out_path: Path, fingerprint: str
     directory = request.directory or out_path.with_name(out_path.stem + "_histories")
     cases = request.select(ds, design)
     attrs = {"pipeline": pipe.text, "pipeline_source": str(pipe.source),
-             "solver_options": json.dumps(pipe.solver, sort_keys=True)}
+             "solver_options": json.dumps(pipe.solver, sort_keys=True),
+             "im_display_units": pipe.im_display[0], "im_display_factor": pipe.im_display[1]}
     written = write_histories(design, records, cases, directory, pipe.solver, fingerprint,
                               attrs, progress)
     files = np.full(design.n_cases, "", dtype=object)
@@ -1371,5 +1372,7 @@ def _rerun(path, record, im_level=None, im_level_g=None, **sweep):
     result = run_case(design, records, case, pipe.solver)
     ds = case_dataset(result, design, records, case,
                       {"pipeline": pipe.text, "pipeline_source": str(pipe.source),
-                       "solver_options": json.dumps(pipe.solver, sort_keys=True)})
+                       "solver_options": json.dumps(pipe.solver, sort_keys=True),
+                       "im_display_units": pipe.im_display[0],
+                       "im_display_factor": pipe.im_display[1]})
     return ds, result
