@@ -464,18 +464,30 @@ def cmd_plot(args):
     figure = args.figure or str(Path(args.results).with_suffix(".png"))
     if "x_b" in ds and "time" in ds.dims:
         _save_figure(lambda: _response_figure(ds, _run_name(ds)), figure)
-    elif "median" in ds and args.kind == "ida":
-        from shipblock.plot import plot_ida
+        sys.stdout.write(f"figure written to {figure}\n")
+        return 0
+    if "median" not in ds:
+        raise UserError(f"{args.results}: neither a simulation response nor a fragility result")
+    from shipblock.plot import plot_fragility, plot_ida, plot_median_sweep, sweep_selection
 
+    try:
+        sweep = sweep_selection(ds, _parse_assignments(args.set))
+    except ValueError as exc:
+        raise UserError(f"{args.results}: --set {exc}") from None
+    if args.kind == "ida":
         if args.edp not in ds:
             raise UserError(f"{args.results}: no demand parameter {args.edp!r}")
-        _save_figure(lambda: plot_ida(ds, args.edp).figure, figure)
-    elif "median" in ds:
-        from shipblock.plot import plot_fragility
-
-        _save_figure(lambda: plot_fragility(ds).figure, figure)
+        _save_figure(lambda: plot_ida(ds, args.edp, sweep=sweep).figure, figure)
+    elif args.kind == "median":
+        if not sweep:
+            raise UserError(f"{args.results}: --kind median needs a study with a [sweep]")
+        against = args.against or next(iter(sweep))
+        if against not in sweep:
+            raise UserError(f"{args.results}: --against {against!r} is not a swept parameter; "
+                            f"swept: {', '.join(sweep)}")
+        _save_figure(lambda: plot_median_sweep(ds, against, sweep=sweep).figure, figure)
     else:
-        raise UserError(f"{args.results}: neither a simulation response nor a fragility result")
+        _save_figure(lambda: plot_fragility(ds, sweep=sweep).figure, figure)
     sys.stdout.write(f"figure written to {figure}\n")
     return 0
 
@@ -581,9 +593,16 @@ def build_parser():
     # --output too: 'simulate' and 'history' name their NetCDF so, and here the output is the PNG
     s.add_argument("--figure", "--output", "-o", dest="figure",
                    help="PNG path (default: next to the results)")
-    s.add_argument("--kind", choices=["fragility", "ida"], default="fragility",
-                   help="for batch results: fragility curves (default) or IDA curves")
+    s.add_argument("--kind", choices=["fragility", "ida", "median"], default="fragility",
+                   help="for batch results: fragility curves (default), IDA curves, or the "
+                        "fitted median against a swept parameter")
     s.add_argument("--edp", default="peak_ship_slip", help="demand parameter of the IDA curves")
+    s.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help="value of a swept parameter to draw, e.g. --set mu_ground=0.5 "
+                        "(repeatable; default: the first value of each)")
+    s.add_argument("--against", metavar="NAME",
+                   help="with --kind median: the swept parameter on the x axis (default: the "
+                        "first)")
     s.set_defaults(func=cmd_plot)
 
     s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "

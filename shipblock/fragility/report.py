@@ -107,7 +107,7 @@ def fit_lines(ds: xr.Dataset) -> list[str]:
                 lines.append(f"  {name:<24} not fitted: {error.split(': ', 1)[-1]}")
                 continue
             band = f" ({band})" if band else ""
-            lines.append(f"  {name:<24} median {label} {median}{band}, beta "
+            lines.append(f"  {name:<24} median {median}{band}, beta "
                          f"{float(ds['beta'].sel(sel)):.3f}")
             if error:
                 lines.append(f"  {'':<24} ({error})")
