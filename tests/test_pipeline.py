@@ -547,3 +547,75 @@ def test_dask_equals_local(ida_run, tmp_path):
     with local_dask_client() as client:
         remote = run_pipeline(path, output=tmp_path / "dask.nc", client=client, progress=False)
     assert_same_results(local, remote)
+
+
+# -------------------------------------------------------------------------------------------
+# scaling to a target spectrum
+# -------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("match", ["range", "anchor"])
+def test_msa_scaled_to_a_target_spectrum(tmp_path, match):
+    """Levels are Sa(1 s); the target file (in g) is anchored to each level at T1 = 1 s.
+
+    'range': each record's scaled spectrum is the least-squares fit, in ln Sa over 0.2-2 s, of
+    the anchored target (its log residuals average zero); 'anchor': Sa(T1) equals the level.
+    The misfit stored is the RMS of those residuals, smaller for 'range'; a run made again
+    alone gets the batch's factors (the same summary)."""
+    from shipblock.fragility.pipeline import rerun_case
+    from shipblock.scaling import read_target_spectrum
+
+    (tmp_path / "target.csv").write_text(
+        "period_s, sa_g\n0.05, 0.5\n0.2, 1.0\n0.6, 1.0\n2.0, 0.3\n4.0, 0.15\n")
+    levels = ('measure = "sa"\nperiod = 1.0\nlevels_g = [0.3, 0.6]\n'
+              '[design.target_spectrum]\nfile = "target.csv"\nunits = "g"\n'
+              f'period_range = [0.2, 2.0]\nmatch = "{match}"\n')
+    path = write_pipeline(tmp_path, kind="msa", levels=levels)
+    ds = run_pipeline(path, progress=False)
+    target = read_target_spectrum(tmp_path / "target.csv", "g")
+    periods = ds["spectrum_period"].values
+    np.testing.assert_allclose(periods, np.geomspace(0.2, 2.0, 40))
+    np.testing.assert_allclose(ds["target_sa"], target.at(periods), rtol=1e-15)
+    levels_si = ds["im_level"].values
+    for r in range(3):
+        for j, level in enumerate(levels_si):
+            f = float(ds["scale_factor"].isel(record=r, im_level=j))
+            anchored = target.at(periods) * level / target.at(1.0)[0]
+            resid = np.log(f * ds["record_sa"].isel(record=r).values / anchored)
+            if match == "range":
+                assert abs(resid.mean()) < 1e-12
+            else:
+                assert float(ds["achieved_im"].isel(record=r, im_level=j)) == pytest.approx(
+                    level, rel=1e-12)
+            assert float(ds["spectrum_misfit"].isel(record=r)) == pytest.approx(
+                np.sqrt(np.mean(resid**2)), rel=1e-10)
+    assert ds.attrs["target_spectrum_match"] == match
+    res = rerun_case(path, "S1", im_level_g=0.6)
+    assert res.summary["peak_ship_slip"] == float(
+        ds["peak_ship_slip"].sel(record="syn/S1").isel(im_level=1))
+
+
+def test_target_spectrum_keys_are_checked(tmp_path):
+    (tmp_path / "target.csv").write_text("0.5 1.0\n1.0 0.8\n")
+    base = 'measure = "sa"\nperiod = 1.0\nlevels_g = [0.3]\n[design.target_spectrum]\n'
+    cases = [
+        ('file = "target.csv"\nunits = "g"\nperiod_range = [0.2, 2.0]\n',
+         "design.target_spectrum.file", "covers 0.5 to 1 s"),
+        ('file = "target.csv"\nperiod_range = [0.6, 0.9]\n', "design.target_spectrum.units",
+         "missing"),
+        ('file = "target.csv"\nunits = "g"\nperiod_range = [0.9, 0.6]\n',
+         "design.target_spectrum.period_range", "0 < T_a < T_b"),
+        ('file = "target.csv"\nunits = "g"\nperiod_range = [0.6, 0.9]\nmatch = "best"\n',
+         "design.target_spectrum.match", "'range'"),
+    ]
+    for i, (table, key, needle) in enumerate(cases):
+        path = write_pipeline(tmp_path, kind="msa", levels=base + table, name=f"p{i}.toml")
+        with pytest.raises(PipelineError, match=needle) as info:
+            load_pipeline(path)
+        assert info.value.key == key
+    path = write_pipeline(tmp_path, kind="msa", name="pga.toml", levels=(
+        'levels_g = [0.3]\n[design.target_spectrum]\nfile = "target.csv"\nunits = "g"\n'
+        'period_range = [0.6, 0.9]\n'))
+    with pytest.raises(PipelineError, match="measure = 'sa'") as info:
+        load_pipeline(path)
+    assert info.value.key == "design.target_spectrum"

@@ -43,6 +43,13 @@ Schema (``schema_version = 1``; units in brackets, paths relative to the pipelin
                                         # msa only, optional: the records of each level
     max_scale_factor = 5.0              # warn about runs scaled by more (default 5) [-]
     scale_factor_policy = "warn"        # or "refuse": runs scaled by more are not made
+
+    [design.target_spectrum]            # optional, ida/msa on measure "sa" (T1 = period)
+    file = "target.csv"                 # two columns: period [s], Sa [units]
+    units = "g"                         # unit of the Sa column (required)
+    period_range = [0.2, 2.0]           # [T_a, T_b] [s]
+    match = "range"                     # least squares in ln Sa over the range (default), or
+                                        # "anchor": Sa(T1) matched, misfit over the range
     cloud_method = "probit"             # cloud only: "probit" or "regression"
 
     [[limit_states]]                    # see shipblock.fragility.limit_states
@@ -254,6 +261,13 @@ _SCHEMA: dict[str, dict[str, tuple]] = {
         "stripes": ((list,), False),
         "max_scale_factor": (_NUM, False),
         "scale_factor_policy": ((str,), False),
+        "target_spectrum": ((dict,), False),
+    },
+    "design.target_spectrum": {
+        "file": ((str,), True),
+        "units": ((str,), True),
+        "period_range": ((list,), True),
+        "match": ((str,), False),
     },
     "fit": {
         "bootstrap": ((int,), False),
@@ -450,6 +464,9 @@ class Pipeline:
         The unit the pipeline gives its IM levels in (``"g"`` for ``levels_g``, else
         ``design.units``) and its value in SI units: the unit of the messages, of the
         command's output and of the result's ``*_g`` companions.
+    target_spectrum : dict or None
+        ``[design.target_spectrum]``: ``spectrum`` (:class:`~shipblock.scaling.TargetSpectrum`),
+        ``file``, ``units``, ``period_range`` [s], ``match``; None without one.
     """
 
     source: str
@@ -472,6 +489,7 @@ class Pipeline:
     scale_factor_policy: str = "warn"
     strict: bool = False
     im_display: tuple[str, float] = ("m/s^2", 1.0)
+    target_spectrum: dict | None = None
 
     def identity(self) -> dict:
         """The parts of the document that determine the results (no output path, scheduler
@@ -740,7 +758,107 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
         scheduler=ex.get("scheduler"), output=(base / doc["output"]).resolve(),
         histories=histories, **_scaling_limits(doc, source),
         im_display=_im_display(d, measure, source),
+        target_spectrum=_target_spectrum(d, intensity, base, source),
     )
+
+
+def _target_spectrum(design: Mapping, intensity: IntensityDesign, base: Path, source: str):
+    """The ``[design.target_spectrum]`` table, read and checked (see ``Pipeline``)."""
+    from shipblock.scaling import MATCH_MODES, TargetSpectrumError, read_target_spectrum
+
+    if "target_spectrum" not in design:
+        return None
+    table = design["target_spectrum"]
+    _check_table(table, "design.target_spectrum", source)
+    key = "design.target_spectrum"
+    if intensity.kind not in ("ida", "msa") or intensity.measure != "sa":
+        raise PipelineError(key, "scaling to a target spectrum needs type 'ida' or 'msa' on "
+                            "measure = 'sa' (its period is T1, where the target is anchored to "
+                            "the levels)", source)
+    rng = _numbers(table["period_range"], f"{key}.period_range", source)
+    if len(rng) != 2 or not 0 < rng[0] < rng[1]:
+        raise PipelineError(f"{key}.period_range", f"must be [T_a, T_b] with 0 < T_a < T_b [s],"
+                            f" got {table['period_range']!r}", source)
+    match = table.get("match", "range")
+    if match not in MATCH_MODES:
+        raise PipelineError(f"{key}.match", f"must be one of {', '.join(map(repr, MATCH_MODES))}"
+                            f", got {match!r}", source)
+    try:
+        spectrum = read_target_spectrum(base / table["file"], table["units"])
+        spectrum.at([rng[0], rng[1], intensity.period])
+    except TargetSpectrumError as exc:
+        raise PipelineError(f"{key}.file", str(exc), source) from None
+    return {"spectrum": spectrum, "file": str(base / table["file"]), "units": table["units"],
+            "period_range": rng, "match": match}
+
+
+def _match_target_spectrum(pipe: Pipeline, record) -> dict | None:
+    """Scale a prepared record to the target spectrum at every level (in place).
+
+    The batch scaled it to Sa(T1) = level (``match = "anchor"``: kept). With ``"range"`` the
+    factor at level ``j`` becomes ``level_j / Sa_target(T1) * f``, ``f`` the least-squares
+    factor of the record to the target over the range (the target anchored at each level is
+    the file's spectrum times ``level_j / Sa_target(T1)``): every factor and achieved IM is
+    multiplied by ``f Sa_record(T1) / Sa_target(T1)``, as is the vertical's in mode "same".
+
+    Returns
+    -------
+    dict or None
+        ``misfit`` [-], ``sa_record`` on the matching periods [m/s^2]; None for a record left
+        out.
+    """
+    from shipblock.scaling import spectrum_match
+
+    target = pipe.target_spectrum
+    if target is None or record.error is not None:
+        return None
+    intensity = pipe.design.intensity
+    try:
+        m = spectrum_match(record.horizontal, record.dt, target["spectrum"],
+                           target["period_range"], mode=target["match"],
+                           anchor_period=intensity.period, damping=intensity.damping)
+    except ShipblockError as exc:
+        record.error = f"{type(exc).__name__}: {exc}"
+        return None
+    if target["match"] == "range":
+        ratio = m.factor * record.im / float(target["spectrum"].at(intensity.period)[0])
+        record.factor_h = record.factor_h * ratio
+        record.achieved = record.achieved * ratio
+        if intensity.vertical == "same":
+            record.factor_v = record.factor_v * ratio
+            record.achieved_v = record.achieved_v * ratio
+    return {"misfit": m.misfit, "periods": m.periods, "sa_record": m.sa_record,
+            "sa_target": m.sa_target}
+
+
+def _spectrum_variables(pipe: Pipeline, matches) -> tuple[dict, dict]:
+    """Variables and attributes of the target-spectrum match (none without a target)."""
+    target = pipe.target_spectrum
+    if target is None:
+        return {}, {}
+    ok = [m for m in matches if m is not None]
+    periods = ok[0]["periods"] if ok else np.geomspace(*target["period_range"], 40)
+    n = periods.size
+    misfit = np.array([np.nan if m is None else m["misfit"] for m in matches])
+    sa = np.array([np.full(n, np.nan) if m is None else m["sa_record"] for m in matches])
+    lo, hi = target["period_range"]
+    coords = {"spectrum_period": ("spectrum_period", periods,
+                                  {"units": "s", "long_name": "period of the spectrum match"})}
+    data = {
+        "spectrum_misfit": (("record",), misfit, {
+            "units": "1", "long_name": f"RMS of ln(Sa scaled / Sa target) from {lo:g} to "
+            f"{hi:g} s (match {target['match']!r})"}),
+        "record_sa": (("record", "spectrum_period"), sa, {
+            "units": "m/s^2", "long_name": "pseudo-spectral acceleration of the processed, "
+                                           "unscaled record"}),
+        "target_sa": (("spectrum_period",), target["spectrum"].at(periods), {
+            "units": "m/s^2", "long_name": "target spectrum as given (at each level it is "
+            "scaled to Sa(T1) = level)"}),
+    }
+    attrs = {"target_spectrum_file": target["file"], "target_spectrum_units": target["units"],
+             "target_spectrum_period_range": list(target["period_range"]),
+             "target_spectrum_match": target["match"]}
+    return {"coords": coords, "data": data}, attrs
 
 
 def _im_display(design: Mapping, measure: str, source: str) -> tuple[str, float]:
@@ -1208,6 +1326,7 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         prepare_record(rid, _loader(entries[rid], pipe), pipe.chain, design.intensity)
         for rid in design.records
     ]
+    matches = [_match_target_spectrum(pipe, r) for r in records]
     above, refused, left_out = _record_use(pipe, records)
     fingerprint = _fingerprint(pipe, records)
     store = ChunkStore(out_path.with_name(out_path.name + ".partial"), fingerprint)
@@ -1270,6 +1389,11 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     if intensity.period is not None:
         ds.attrs["im_period"] = intensity.period
     ds = _add_record_use(ds, pipe, records, above, refused, left_out)
+    spectrum, spectrum_attrs = _spectrum_variables(pipe, matches)
+    if spectrum:
+        ds = ds.assign_coords({k: xr.Variable(*v) for k, v in spectrum["coords"].items()})
+        ds = ds.assign({k: xr.Variable(*v) for k, v in spectrum["data"].items()})
+        ds.attrs.update(spectrum_attrs)
     clock.lap("fragility")
     if pipe.histories is not None:
         ds = _add_histories(ds, pipe, records, out_path, fingerprint, progress)
@@ -1369,6 +1493,7 @@ def _rerun(path, record, im_level=None, im_level_g=None, **sweep):
     records = [None] * len(design.records)
     records[r] = prepare_record(rid, _loader(load_catalogue(pipe.catalogue)[rid], pipe),
                                 pipe.chain, design.intensity)
+    _match_target_spectrum(pipe, records[r])
     result = run_case(design, records, case, pipe.solver)
     ds = case_dataset(result, design, records, case,
                       {"pipeline": pipe.text, "pipeline_source": str(pipe.source),

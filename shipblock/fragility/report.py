@@ -165,6 +165,22 @@ def _scale_factor_line(ds: xr.Dataset) -> str | None:
             f"{im_label(ds).split(' [')[0]} {level:.3g} {unit})")
 
 
+def _spectrum_line(ds: xr.Dataset) -> str | None:
+    if "spectrum_misfit" not in ds:
+        return None
+    misfit = ds["spectrum_misfit"].values
+    misfit = misfit[np.isfinite(misfit)]
+    lo, hi = ds.attrs.get("target_spectrum_period_range", [np.nan, np.nan])
+    match = ds.attrs.get("target_spectrum_match", "")
+    how = ("least squares in ln Sa over" if match == "range" else
+           "Sa(T1) matched, misfit over")
+    text = f"target spectrum {ds.attrs.get('target_spectrum_file', '')} ({how} {lo:g} to {hi:g} s)"
+    if not misfit.size:
+        return text + ": no record matched"
+    return (text + f": misfit (RMS of ln Sa ratios) {misfit.min():.3g} to {misfit.max():.3g}, "
+            f"mean {misfit.mean():.3g} (per record in spectrum_misfit)")
+
+
 def _solver_error_line(ds: xr.Dataset) -> str | None:
     if "run_error" not in ds:
         return None
@@ -188,12 +204,12 @@ def study_report(ds: xr.Dataset) -> list[str]:
     -------
     list of str
         Records used (``"5 of 6 records used, 1 left out: NP.1737 (why)"``), scale factors and
-        their limit, solver errors, and :func:`fit_lines`.
+        their limit, the target-spectrum misfits, solver errors, and :func:`fit_lines`.
     """
     lines = []
     if "records_used" in ds.attrs:
         lines.append(str(ds.attrs["records_used"]))
-    for line in (_scale_factor_line(ds), _solver_error_line(ds)):
+    for line in (_scale_factor_line(ds), _spectrum_line(ds), _solver_error_line(ds)):
         if line:
             lines.append(line)
     return lines + fit_lines(ds)
