@@ -233,7 +233,16 @@ def _report(res, name, max_events):
         ("residual x_b / x_s", f"{100 * s['residual_block_slip']:.3f} / "
                                f"{100 * s['residual_ship_slip']:.3f} cm"),
         ("uplift / impacts", f"{'yes' if s['uplift'] else 'no'} / {s['n_impacts']}"),
+        ("peak loads per block", f"floor {s['peak_ground_normal_force'] / 1e3:.1f} kN, friction "
+                                 f"{s['peak_ground_friction_force'] / 1e3:.1f} kN "
+                                 f"(utilisation {s['peak_ground_friction_utilisation']:.2f}); ship "
+                                 f"{s['peak_ship_normal_force'] / 1e3:.1f} kN, friction "
+                                 f"{s['peak_ship_friction_force'] / 1e3:.1f} kN "
+                                 f"(utilisation {s['peak_ship_friction_utilisation']:.2f})"),
     ]
+    if s["uplift"]:
+        rows.append(("peak corner load", f"{s['peak_corner_load'] / 1e3:.1f} kN per block, on "
+                                         "the pivot edge while rocking"))
     width = max(len(r[0]) for r in rows)
     for key, val in rows:
         out.write(f"{key:<{width}}  {val}\n")
