@@ -167,3 +167,28 @@ def test_a_limit_state_on_the_keel_block_load():
     ex = exceedance(ls, summary)
     np.testing.assert_array_equal(ex.exceeded, [False, True, True, False])
     np.testing.assert_array_equal(ex.valid, [True, True, True, False])
+
+
+@pytest.mark.parametrize("vertical", [False, True])
+def test_peaks_over_rest_are_those_of_the_samples_exactly(vertical):
+    """A random record too weak to move anything: the forces are linear between samples, so the
+    summary's peaks are the maxima over the history's samples, to rounding (the kernel takes
+    them from the extremes of the input over each span)."""
+    rng = np.random.default_rng(4)
+    ax = 0.2 * G * rng.uniform(-1, 1, 2000)
+    ay = 0.2 * G * rng.uniform(-1, 1, 2000) if vertical else None
+    res = simulate(SYSTEM, ax, ay, DT)
+    assert (res.mode == 1).all()
+    f = res.forces
+    expect = {
+        "peak_ground_normal_force": np.max(f.ground_normal),
+        "peak_ground_friction_force": np.max(np.abs(f.ground_friction)),
+        "peak_ship_normal_force": np.max(f.ship_normal),
+        "peak_ship_friction_force": np.max(np.abs(f.ship_friction)),
+        "peak_ground_friction_utilisation": np.max(f.ground_utilisation),
+        "peak_ship_friction_utilisation": np.max(f.ship_utilisation),
+    }
+    for name, value in expect.items():
+        assert res.summary[name] == pytest.approx(value, rel=1e-12), name
+    if vertical:  # the largest friction and the largest utilisation at different samples
+        assert np.argmax(np.abs(f.ground_friction)) != np.argmax(f.ground_utilisation)

@@ -87,6 +87,82 @@ def _note_response(p, wa, wg, a, G, summary):
                wa[I_SFX] * a + wg[I_SFX] * G, wa[I_SFY] * a + wg[I_SFY] * G, summary)
 
 
+#: Samples checked at once against the running extremes of :func:`_extremes` (the extremes of
+#: a record settle early, so most blocks are passed by one vectorised comparison).
+EXTREMES_BLOCK = 64
+
+
+@njit(cache=True, _nrt=False)
+def _extremes(ax, k0, k1):  # pragma: no cover - numba kernel
+    """Least and greatest of ``ax[k0:k1]`` (``inf, -inf`` if empty).
+
+    A block of samples all inside the running ``[lo, hi]`` is passed after one branch-free
+    count (vectorised); only blocks holding a new extreme are scanned.
+    """
+    lo = math.inf
+    hi = -math.inf
+    j = k0
+    while j < k1:
+        end = min(j + EXTREMES_BLOCK, k1)
+        if end - j == EXTREMES_BLOCK and lo <= hi:
+            block = ax[j:end]
+            outside = 0
+            for i in range(EXTREMES_BLOCK):
+                x = block[i]
+                outside += (x < lo) | (x > hi)
+            if outside == 0:
+                j = end
+                continue
+        for i in range(j, end):
+            x = ax[i]
+            if x < lo:
+                lo = x
+            if x > hi:
+                hi = x
+        j = end
+    return lo, hi
+
+
+@njit(cache=True, _nrt=False)
+def _extremes_with_vertical(ax, ay, sh, sv, grav, fx_a, fx_g, Fx_a, Fx_g, k0, k1):  # pragma: no cover
+    """Extremes over samples ``k0:k1`` of ``fx``, ``Fx``, ``G = g + a_y`` and ``a / G``, by
+    blocks as :func:`_extremes`."""
+    fx_lo = Fx_lo = g_lo = r_lo = math.inf
+    fx_hi = Fx_hi = g_hi = r_hi = -math.inf
+    j = k0
+    while j < k1:
+        end = min(j + EXTREMES_BLOCK, k1)
+        if end - j == EXTREMES_BLOCK and fx_lo <= fx_hi:
+            bx = ax[j:end]
+            by = ay[j:end]
+            outside = 0
+            for i in range(EXTREMES_BLOCK):
+                a = sh * bx[i]
+                g_tot = grav + sv * by[i]
+                fx = fx_a * a + fx_g * g_tot
+                Fx = Fx_a * a + Fx_g * g_tot
+                # r = a / G outside [r_lo, r_hi], without the division (G > 0 in the span: the
+                # normal forces are positive while the mode holds)
+                outside += ((fx < fx_lo) | (fx > fx_hi) | (Fx < Fx_lo) | (Fx > Fx_hi)
+                            | (g_tot < g_lo) | (g_tot > g_hi) | (a < r_lo * g_tot)
+                            | (a > r_hi * g_tot))
+            if outside == 0:
+                j = end
+                continue
+        for i in range(j, end):
+            a = sh * ax[i]
+            g_tot = grav + sv * ay[i]
+            fx = fx_a * a + fx_g * g_tot
+            Fx = Fx_a * a + Fx_g * g_tot
+            r = a / g_tot
+            fx_lo, fx_hi = min(fx_lo, fx), max(fx_hi, fx)
+            Fx_lo, Fx_hi = min(Fx_lo, Fx), max(Fx_hi, Fx)
+            g_lo, g_hi = min(g_lo, g_tot), max(g_hi, g_tot)
+            r_lo, r_hi = min(r_lo, r), max(r_hi, r)
+        j = end
+    return fx_lo, fx_hi, Fx_lo, Fx_hi, g_lo, g_hi, r_lo, r_hi
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def span_loads(p, ms, work, ax, ay, has_ay, sh, sv, dt, k0, tau0, k1, tau1, summary):
     """Peaks of the contact loads over a non-rocking span, from ``t_k0 + tau0`` to
@@ -95,8 +171,12 @@ def span_loads(p, ms, work, ax, ay, has_ay, sh, sv, dt, k0, tau0, k1, tau1, summ
     The mode's forces are ``a w_a + G w_G`` (``G = g + a_y``; the response vectors of
     :func:`~shipblock.solver._closed_form.mode_response_start`, solved by the span), linear in
     time between samples: their peaks, and those of the utilisations, are at the span's ends or
-    at its samples. Without a vertical input ``G = g`` and every force is affine in ``a``
-    alone, so the least and greatest sample of ``a`` stand for all the samples.
+    at its samples. With nothing rotating the normal forces do not depend on ``a``
+    (``fy = fy_G G``, ``Fy = Fy_G G``), so over the samples: the peak normal forces are those
+    of the greatest ``G``; the peak ``|fx|`` that of the greatest or least ``fx``; the peak
+    utilisation ``|fx_a (a/G) + fx_G| / (mu fy_G)`` that of the greatest or least ``a/G``.
+    Without a vertical input ``G = g`` and the least and greatest sample of ``a`` stand for
+    all. (A mode whose normal forces did depend on ``a`` would be scanned sample by sample.)
     """
     start = mode_response_start(p, work, ms[MS_SLIP1], float(ms[MS_SIG1]), ms[MS_SLIP2],
                                 float(ms[MS_SIG2]))
@@ -110,18 +190,37 @@ def span_loads(p, ms, work, ax, ay, has_ay, sh, sv, dt, k0, tau0, k1, tau1, summ
     a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k1, tau1, dt)
     _note_response(p, wa, wg, a, grav + b, summary)
     last = min(k1, ax.shape[0] - 1)
-    if has_ay:
-        for j in range(k0 + 1, last + 1):
-            _note_response(p, wa, wg, sh * ax[j], grav + sv * ay[j], summary)
+    if k0 + 1 > last:
         return
-    lo = math.inf
-    hi = -math.inf
-    for j in range(k0 + 1, last + 1):
-        lo = min(lo, ax[j])
-        hi = max(hi, ax[j])
-    if lo <= hi:
+    if wa[I_FY] != 0.0 or wa[I_SFY] != 0.0:
+        for j in range(k0 + 1, last + 1):
+            _note_response(p, wa, wg, sh * ax[j], grav + (sv * ay[j] if has_ay else 0.0),
+                           summary)
+        return
+    if not has_ay:
+        lo, hi = _extremes(ax, k0 + 1, last + 1)
         _note_response(p, wa, wg, sh * lo, grav, summary)
         _note_response(p, wa, wg, sh * hi, grav, summary)
+        return
+    fx_lo, fx_hi, Fx_lo, Fx_hi, G_lo, G_hi, r_lo, r_hi = _extremes_with_vertical(
+        ax, ay, sh, sv, grav, wa[I_FX], wg[I_FX], wa[I_SFX], wg[I_SFX], k0 + 1, last + 1)
+    fy_g = wg[I_FY]
+    Fy_g = wg[I_SFY]
+    G_top = G_hi if fy_g >= 0.0 else G_lo
+    note_loads(p, 0, 0.0, fy_g * G_top, 0.0, Fy_g * (G_hi if Fy_g >= 0.0 else G_lo), summary)
+    note_loads(p, 0, fx_lo, -math.inf, Fx_lo, -math.inf, summary)
+    note_loads(p, 0, fx_hi, -math.inf, Fx_hi, -math.inf, summary)
+    # utilisations: |fx| / (mu fy) = |fx_a r + fx_G| / (mu fy_G) at the extreme r = a / G (the
+    # normal forces positive: G > 0 while the mode holds)
+    for r in (r_lo, r_hi):
+        if fy_g > 0.0 and p[P_MUS1] > 0.0:
+            u = abs(wa[I_FX] * r + wg[I_FX]) / (p[P_MUS1] * fy_g)
+            if u > summary[S_PEAK_UTIL_G]:
+                summary[S_PEAK_UTIL_G] = u
+        if Fy_g > 0.0 and p[P_MUS2] > 0.0:
+            u = abs(wa[I_SFX] * r + wg[I_SFX]) / (p[P_MUS2] * Fy_g)
+            if u > summary[S_PEAK_UTIL_S]:
+                summary[S_PEAK_UTIL_S] = u
 
 
 @njit(cache=True, _nrt=False)
