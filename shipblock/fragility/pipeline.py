@@ -89,7 +89,9 @@ the result's ``history_file`` variable.
 IM levels are converted to SI once, here: ``levels_g`` multiplies by
 :data:`shipblock.units.STANDARD_GRAVITY`; ``levels`` with ``units`` goes through
 :func:`shipblock.units.acceleration_to_si` (:func:`shipblock.units.velocity_to_si` for PGV).
-The dataset stores the levels, medians and achieved IMs in SI.
+The dataset stores the levels, medians and achieved IMs in SI; with ``levels_g`` the levels and
+medians also in g (``im_level_g``, ``median_g``, ...), and the fits, their messages and the
+command's output use the pipeline's unit.
 """
 
 from __future__ import annotations
@@ -173,9 +175,8 @@ SCHEMA_VERSION = 1
 #: Default largest number of time-history files of a pipeline's [histories] request.
 DEFAULT_MAX_HISTORIES = 100
 
-#: Default largest scale factor of a run made without a warning [-] (a common practical
-#: ceiling for amplitude scaling; ASCE 7-22 commentary and PEER practice keep factors within
-#: about 0.25 to 4-5).
+#: Default largest scale factor of a run made without a warning [-]: a common practical
+#: ceiling of amplitude scaling (studies commonly keep factors below about 4 to 5).
 DEFAULT_MAX_SCALE_FACTOR = 5.0
 
 #: Defaults of the [fit] table.
