@@ -233,7 +233,16 @@ def _report(res, name, max_events):
         ("residual x_b / x_s", f"{100 * s['residual_block_slip']:.3f} / "
                                f"{100 * s['residual_ship_slip']:.3f} cm"),
         ("uplift / impacts", f"{'yes' if s['uplift'] else 'no'} / {s['n_impacts']}"),
+        ("peak loads per block", f"floor {s['peak_ground_normal_force'] / 1e3:.1f} kN, friction "
+                                 f"{s['peak_ground_friction_force'] / 1e3:.1f} kN "
+                                 f"(utilisation {s['peak_ground_friction_utilisation']:.2f}); ship "
+                                 f"{s['peak_ship_normal_force'] / 1e3:.1f} kN, friction "
+                                 f"{s['peak_ship_friction_force'] / 1e3:.1f} kN "
+                                 f"(utilisation {s['peak_ship_friction_utilisation']:.2f})"),
     ]
+    if s["uplift"]:
+        rows.append(("peak corner load", f"{s['peak_corner_load'] / 1e3:.1f} kN per block, on "
+                                         "the pivot edge while rocking"))
     width = max(len(r[0]) for r in rows)
     for key, val in rows:
         out.write(f"{key:<{width}}  {val}\n")
@@ -277,7 +286,7 @@ def cmd_history(args):
     name = ds.attrs["record"]
     level = ""
     if "im_level" in ds.attrs:
-        level = f" at {ds.attrs['im_level']:.4g} {ds.attrs['im_units']}"
+        level = f" at {_run_name(ds).rsplit(', ', 1)[-1]}"
     sys.stdout.write(f"run {ds.attrs['case']} of {args.pipeline}: {name}{level}, scale factor "
                      f"{ds.attrs['scale_factor']:.4g}\n")
     _report(res, name, args.events)
@@ -292,7 +301,10 @@ def _run_name(ds):
     name = ds.attrs.get("record", "")
     if name and "im_level" in ds.attrs:
         value, unit = float(ds.attrs["im_level"]), ds.attrs.get("im_units", "")
-        if unit == "m/s^2":
+        if "im_display_units" in ds.attrs:  # the unit the pipeline gave its levels in
+            value /= float(ds.attrs["im_display_factor"])
+            unit = ds.attrs["im_display_units"]
+        elif unit == "m/s^2":
             value, unit = value / STANDARD_GRAVITY, "g"
         measure = ds.attrs.get("im_measure", "IM").upper().replace("SA", "Sa")
         name += f", {measure} {value:.3g} {unit}"
@@ -436,28 +448,10 @@ def cmd_run(args):
                       progress=not args.quiet)
     out = sys.stdout
     out.write(f"results written to {ds.encoding.get('source', args.output or 'the pipeline output')}\n")
-    if "median" in ds:
-        from shipblock.plot import _im_axis
+    from shipblock.fragility.report import study_report
 
-        out.write("fitted fragility (lognormal):\n")
-        for ls in ds["limit_state"].values:
-            med = ds["median"].sel(limit_state=ls)
-            beta = ds["beta"].sel(limit_state=ls)
-            error = str(ds["fit_error"].sel(limit_state=ls).values) if "fit_error" in ds else ""
-            if med.ndim == 0 and error:
-                # e.g. too few exceedances to identify beta: say why instead of printing nan
-                out.write(f"  {str(ls):<24} not fitted: {error.split(': ', 1)[-1]}\n")
-            elif med.ndim == 0:
-                value, label, _ = _im_axis(ds, [float(med)])
-                band = ""
-                if "median_lower" in ds:
-                    lo, _, _ = _im_axis(ds, [float(ds["median_lower"].sel(limit_state=ls))])
-                    hi, _, _ = _im_axis(ds, [float(ds["median_upper"].sel(limit_state=ls))])
-                    band = f" ({lo[0]:.3g} to {hi[0]:.3g})"
-                out.write(f"  {str(ls):<24} median {label} {value[0]:.3g}{band}, "
-                          f"beta {float(beta):.3f}\n")
-            else:
-                out.write(f"  {str(ls):<24} fitted per swept parameter (see the NetCDF)\n")
+    for line in study_report(ds):
+        out.write(line + "\n")
     if "history_file" in ds:
         n = int((ds["history_file"] != "").sum())
         folder = Path(ds.encoding.get("source", ".")).parent / ds.attrs["histories_directory"]
@@ -479,18 +473,30 @@ def cmd_plot(args):
     figure = args.figure or str(Path(args.results).with_suffix(".png"))
     if "x_b" in ds and "time" in ds.dims:
         _save_figure(lambda: _response_figure(ds, _run_name(ds)), figure)
-    elif "median" in ds and args.kind == "ida":
-        from shipblock.plot import plot_ida
+        sys.stdout.write(f"figure written to {figure}\n")
+        return 0
+    if "median" not in ds:
+        raise UserError(f"{args.results}: neither a simulation response nor a fragility result")
+    from shipblock.plot import plot_fragility, plot_ida, plot_median_sweep, sweep_selection
 
+    try:
+        sweep = sweep_selection(ds, _parse_assignments(args.set))
+    except ValueError as exc:
+        raise UserError(f"{args.results}: --set {exc}") from None
+    if args.kind == "ida":
         if args.edp not in ds:
             raise UserError(f"{args.results}: no demand parameter {args.edp!r}")
-        _save_figure(lambda: plot_ida(ds, args.edp).figure, figure)
-    elif "median" in ds:
-        from shipblock.plot import plot_fragility
-
-        _save_figure(lambda: plot_fragility(ds).figure, figure)
+        _save_figure(lambda: plot_ida(ds, args.edp, sweep=sweep).figure, figure)
+    elif args.kind == "median":
+        if not sweep:
+            raise UserError(f"{args.results}: --kind median needs a study with a [sweep]")
+        against = args.against or next(iter(sweep))
+        if against not in sweep:
+            raise UserError(f"{args.results}: --against {against!r} is not a swept parameter; "
+                            f"swept: {', '.join(sweep)}")
+        _save_figure(lambda: plot_median_sweep(ds, against, sweep=sweep).figure, figure)
     else:
-        raise UserError(f"{args.results}: neither a simulation response nor a fragility result")
+        _save_figure(lambda: plot_fragility(ds, sweep=sweep).figure, figure)
     sys.stdout.write(f"figure written to {figure}\n")
     return 0
 
@@ -596,9 +602,16 @@ def build_parser():
     # --output too: 'simulate' and 'history' name their NetCDF so, and here the output is the PNG
     s.add_argument("--figure", "--output", "-o", dest="figure",
                    help="PNG path (default: next to the results)")
-    s.add_argument("--kind", choices=["fragility", "ida"], default="fragility",
-                   help="for batch results: fragility curves (default) or IDA curves")
+    s.add_argument("--kind", choices=["fragility", "ida", "median"], default="fragility",
+                   help="for batch results: fragility curves (default), IDA curves, or the "
+                        "fitted median against a swept parameter")
     s.add_argument("--edp", default="peak_ship_slip", help="demand parameter of the IDA curves")
+    s.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help="value of a swept parameter to draw, e.g. --set mu_ground=0.5 "
+                        "(repeatable; default: the first value of each)")
+    s.add_argument("--against", metavar="NAME",
+                   help="with --kind median: the swept parameter on the x axis (default: the "
+                        "first)")
     s.set_defaults(func=cmd_plot)
 
     s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "

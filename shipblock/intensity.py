@@ -61,7 +61,7 @@ __all__ = [
     "CAV5_THRESHOLD",
     "DEFAULT_DAMPING",
     "DEFAULT_PERIODS",
-    "Peak",
+    "SAMPLES_PER_PERIOD",
     "ResponseSpectrum",
     "arias_intensity",
     "cav",
@@ -73,6 +73,7 @@ __all__ = [
     "pga",
     "pgd",
     "pgv",
+    "peak_time",
     "response_spectrum",
     "sdof_response",
     "significant_duration",
@@ -89,20 +90,11 @@ DEFAULT_DAMPING = 0.05
 #: Default oscillator periods of :func:`intensity_measures` [s]; ``0`` stands for PGA.
 DEFAULT_PERIODS = (0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0)
 
-
-class Peak(NamedTuple):
-    r"""Peak absolute value of a time series and when it occurs.
-
-    Attributes
-    ----------
-    value : float
-        :math:`\max_i |x_i|` in the units of the series (always >= 0).
-    time : float
-        Time of the (first) peak, measured from the first sample [s].
-    """
-
-    value: float
-    time: float
+#: Fewest response samples per oscillator period of :func:`response_spectrum` [-]: an
+#: oscillator with ``T < SAMPLES_PER_PERIOD * dt`` is integrated on the record oversampled by
+#: linear interpolation. The peak of a harmonic response sampled ``r`` times per period is
+#: missed by at most ``1 - cos(pi / r)``: 1.2 % at ``r = 20``, 0.05 % at ``r = 100``.
+SAMPLES_PER_PERIOD = 100
 
 
 class ResponseSpectrum(NamedTuple):
@@ -225,13 +217,28 @@ def displacement(acc, dt) -> np.ndarray:
     return d
 
 
-def _peak(x: np.ndarray, dt: float) -> Peak:
-    i = int(np.argmax(np.abs(x)))
-    return Peak(float(abs(x[i])), i * dt)
+def pga(acc, dt) -> float:
+    r"""Peak ground acceleration :math:`\max_i |a_i|`.
+
+    Parameters
+    ----------
+    acc : array_like
+        Ground acceleration [m/s^2], shape ``(n,)``.
+    dt : float
+        Time step [s] (checked; the peak of samples does not depend on it).
+
+    Returns
+    -------
+    float
+        PGA [m/s^2], >= 0. Its time is :func:`peak_time` ``(acc, dt, "pga")``.
+    """
+    a = _as_record(acc)
+    _check_dt(dt)
+    return float(np.max(np.abs(a)))
 
 
-def pga(acc, dt) -> Peak:
-    r"""Peak ground acceleration and its time.
+def pgv(acc, dt) -> float:
+    """Peak ground velocity, velocity from :func:`velocity`.
 
     Parameters
     ----------
@@ -242,14 +249,14 @@ def pga(acc, dt) -> Peak:
 
     Returns
     -------
-    Peak
-        ``value`` = :math:`\max_i |a_i|` [m/s^2] and ``time`` [s] from the first sample.
+    float
+        PGV [m/s], >= 0. Its time is :func:`peak_time` ``(acc, dt, "pgv")``.
     """
-    return _peak(_as_record(acc), _check_dt(dt))
+    return float(np.max(np.abs(velocity(acc, dt))))
 
 
-def pgv(acc, dt) -> Peak:
-    """Peak ground velocity and its time, velocity from :func:`velocity`.
+def pgd(acc, dt) -> float:
+    """Peak ground displacement, displacement from :func:`displacement`.
 
     Parameters
     ----------
@@ -260,14 +267,17 @@ def pgv(acc, dt) -> Peak:
 
     Returns
     -------
-    Peak
-        ``value`` [m/s] and ``time`` [s].
+    float
+        PGD [m], >= 0. Its time is :func:`peak_time` ``(acc, dt, "pgd")``.
     """
-    return _peak(velocity(acc, dt), _check_dt(dt))
+    return float(np.max(np.abs(displacement(acc, dt))))
 
 
-def pgd(acc, dt) -> Peak:
-    """Peak ground displacement and its time, displacement from :func:`displacement`.
+_PEAK_SERIES = {"pga": lambda a, dt: a, "pgv": velocity, "pgd": displacement}
+
+
+def peak_time(acc, dt, measure="pga") -> float:
+    """Time of the (first) sample at which PGA, PGV or PGD is reached.
 
     Parameters
     ----------
@@ -275,13 +285,19 @@ def pgd(acc, dt) -> Peak:
         Ground acceleration [m/s^2], shape ``(n,)``.
     dt : float
         Time step [s].
+    measure : {"pga", "pgv", "pgd"}
+        The peak whose time is wanted.
 
     Returns
     -------
-    Peak
-        ``value`` [m] and ``time`` [s].
+    float
+        Time from the first sample [s].
     """
-    return _peak(displacement(acc, dt), _check_dt(dt))
+    if measure not in _PEAK_SERIES:
+        raise ParameterError(f"measure must be one of {', '.join(_PEAK_SERIES)}, got {measure!r}")
+    a = _as_record(acc)
+    dt = _check_dt(dt)
+    return float(np.argmax(np.abs(_PEAK_SERIES[measure](a, dt)))) * dt
 
 
 # --------------------------------------------------------------------------------------------
@@ -474,7 +490,7 @@ def cav5(acc, dt, threshold=CAV5_THRESHOLD) -> float:
 # --------------------------------------------------------------------------------------------
 # response spectrum: Nigam-Jennings (1969) recursion
 # --------------------------------------------------------------------------------------------
-def _nigam_jennings_coefficients(omega: np.ndarray, zeta: float, dt: float):
+def _nigam_jennings_coefficients(omega: np.ndarray, zeta: float, dt):
     r"""Coefficients of the exact recursion for piecewise-linear forcing (Chopra Table 5.2.1).
 
     For :math:`\ddot u + 2\zeta\omega\dot u + \omega^2 u = p(t)` with :math:`p` linear in
@@ -511,10 +527,13 @@ def _nigam_jennings_coefficients(omega: np.ndarray, zeta: float, dt: float):
 
 
 @njit(cache=True)
-def _max_abs_displacement(acc, a, b, c, d, ap, bp, cp, dp):  # pragma: no cover - numba kernel
+def _max_abs_displacement(acc, sub, a, b, c, d, ap, bp, cp, dp):  # pragma: no cover - numba
     """Peak |u| of SDOF oscillators at rest at t=0 under ground acceleration ``acc``.
 
-    Loads are ``p_i = -acc_i``. Outer loop over oscillators, inner over samples.
+    Loads are ``p_i = -acc_i``. Outer loop over oscillators, inner over samples. Oscillator
+    ``j`` takes ``sub[j]`` steps per sample interval (its coefficients are those of
+    ``dt / sub[j]``), with the load linear within the interval: the same piecewise-linear
+    input, its response seen ``sub[j]`` times per sample.
     """
     m = a.shape[0]
     n = acc.shape[0]
@@ -525,15 +544,31 @@ def _max_abs_displacement(acc, a, b, c, d, ap, bp, cp, dp):  # pragma: no cover 
         umax = 0.0
         aj, bj, cj, dj = a[j], b[j], c[j], d[j]
         apj, bpj, cpj, dpj = ap[j], bp[j], cp[j], dp[j]
-        for i in range(n - 1):
-            p0 = -acc[i]
-            p1 = -acc[i + 1]
-            un = aj * u + bj * v + cj * p0 + dj * p1
-            v = apj * u + bpj * v + cpj * p0 + dpj * p1
-            u = un
-            au = abs(u)
-            if au > umax:
-                umax = au
+        k = sub[j]
+        if k == 1:
+            for i in range(n - 1):
+                p0 = -acc[i]
+                p1 = -acc[i + 1]
+                un = aj * u + bj * v + cj * p0 + dj * p1
+                v = apj * u + bpj * v + cpj * p0 + dpj * p1
+                u = un
+                au = abs(u)
+                if au > umax:
+                    umax = au
+        else:
+            for i in range(n - 1):
+                q0 = -acc[i]
+                dq = (-acc[i + 1] - q0) / k
+                p0 = q0
+                for s in range(1, k + 1):
+                    p1 = -acc[i + 1] if s == k else q0 + dq * s
+                    un = aj * u + bj * v + cj * p0 + dj * p1
+                    v = apj * u + bpj * v + cpj * p0 + dpj * p1
+                    u = un
+                    p0 = p1
+                    au = abs(u)
+                    if au > umax:
+                        umax = au
         out[j] = umax
     return out
 
@@ -581,7 +616,8 @@ def sdof_response(acc, dt, period, damping=DEFAULT_DAMPING):
     return u, v
 
 
-def response_spectrum(acc, dt, periods, damping=DEFAULT_DAMPING) -> ResponseSpectrum:
+def response_spectrum(acc, dt, periods, damping=DEFAULT_DAMPING,
+                      samples_per_period=SAMPLES_PER_PERIOD) -> ResponseSpectrum:
     r"""Elastic displacement and pseudo-acceleration spectra (Nigam & Jennings 1969).
 
     For each period :math:`T` the oscillator
@@ -592,11 +628,22 @@ def response_spectrum(acc, dt, periods, damping=DEFAULT_DAMPING) -> ResponseSpec
     .. math:: S_d(T) = \max_i |u_i|, \qquad PSV = \omega S_d, \qquad S_a = \omega^2 S_d.
 
     ``T = 0`` (an infinitely stiff oscillator) returns :math:`S_d = 0` and
-    :math:`S_a` = PGA. The response is sampled at the record's samples only, so peaks between
-    samples are missed; for :math:`T \lesssim 10\,\Delta t` this under-estimates
-    :math:`S_a` by up to a few per cent (resample the record first if that matters). The peak
-    is taken over the record duration only (no free-vibration tail is appended; pad the record
-    with zeros to include it). The closed-form coefficients lose relative precision by
+    :math:`S_a` = PGA.
+
+    The peak is taken over the response at discrete times, which misses the crests between
+    them: by up to :math:`1 - \cos(\pi\,\Delta t/T)` of a harmonic response, 1.2 % at
+    :math:`T = 20\,\Delta t`. Short-period oscillators are therefore integrated on the record
+    *oversampled*, as pyrotd does for its frequency-domain spectra (Kottke 2019 [3]_), so that
+    there are at least ``samples_per_period`` response samples per period: an oscillator with
+    :math:`T < r\,\Delta t` (``r = samples_per_period``) takes
+    :math:`k = \lceil r\,\Delta t / T\rceil` steps of :math:`\Delta t / k` per sample
+    interval. The oversampling interpolates the record linearly, so the input is the same
+    piecewise-linear function and the recursion stays exact; only the response is seen more
+    often (error at most :math:`1 - \cos(\pi/r)`, 0.05 % for the default 100; tested against
+    the closed-form harmonic response at :math:`T = 20\,\Delta t`, where the plain
+    recursion misses 1.2 %). The cost of such a period grows by :math:`k`. The peak is taken
+    over the record duration only (no free-vibration tail is appended; pad the record with
+    zeros to include it). The closed-form coefficients lose relative precision by
     cancellation as :math:`\omega\Delta t \to 0`, roughly
     :math:`10^{-16}/(\omega\Delta t)^2` (measured against ``scipy.signal.lsim``:
     :math:`10^{-8}` at :math:`T/\Delta t = 10^5`), negligible for earthquake records.
@@ -613,6 +660,10 @@ def response_spectrum(acc, dt, periods, damping=DEFAULT_DAMPING) -> ResponseSpec
         Natural periods [s], ``>= 0``, shape ``(m,)`` or scalar.
     damping : float
         Fraction of critical damping :math:`\zeta` in [0, 1) [-]; default 0.05.
+    samples_per_period : int
+        Fewest response samples per oscillator period [-] (default
+        :data:`SAMPLES_PER_PERIOD`); 1 turns the oversampling off (the response at the
+        record's samples only).
 
     Returns
     -------
@@ -625,25 +676,34 @@ def response_spectrum(acc, dt, periods, damping=DEFAULT_DAMPING) -> ResponseSpec
     .. [1] Nigam, N. C. and Jennings, P. C. (1969). Calculation of response spectra from
        strong-motion earthquake records. *Bull. Seismol. Soc. Am.* 59(2), 909-922.
     .. [2] Chopra, A. K. (2017). *Dynamics of Structures*, 5th ed., Section 5.2.
+    .. [3] Kottke, A. R. (2019). pyrotd: rotated response spectra (``max_freq_ratio``: the
+       record is resampled so that its Nyquist frequency is well above the oscillator's).
+       https://github.com/arkottke/pyrotd
     """
     a_g = _as_record(acc)
     dt = _check_dt(dt)
     zeta = _check_damping(damping)
     periods = _check_periods(periods)
+    r = samples_per_period
+    if isinstance(r, bool) or not isinstance(r, int | np.integer) or r < 1:
+        raise ParameterError(f"samples_per_period must be a whole number >= 1, got {r!r}")
     sd = np.zeros_like(periods)
     omega = np.full_like(periods, np.inf)
     pos = periods > 0.0
     if np.any(pos):
         omega[pos] = 2.0 * np.pi / periods[pos]
-        coef = _nigam_jennings_coefficients(omega[pos], zeta, dt)
-        sd[pos] = _max_abs_displacement(a_g, *(np.ascontiguousarray(x) for x in coef))
+        sub = np.maximum(1, np.ceil(r * dt / periods[pos])).astype(np.int64)
+        coef = _nigam_jennings_coefficients(omega[pos], zeta, dt / sub)
+        sd[pos] = _max_abs_displacement(a_g, sub, *(np.ascontiguousarray(x) for x in coef))
     psv = np.where(pos, np.where(pos, omega, 0.0) * sd, 0.0)
     psa = np.where(pos, np.where(pos, omega, 0.0) ** 2 * sd, np.max(np.abs(a_g)))
     return ResponseSpectrum(periods.copy(), zeta, sd, psv, psa)
 
 
-def spectral_acceleration(acc, dt, periods, damping=DEFAULT_DAMPING):
-    """Pseudo-spectral acceleration :math:`S_a(T)` [m/s^2] (see :func:`response_spectrum`).
+def spectral_acceleration(acc, dt, periods, damping=DEFAULT_DAMPING,
+                          samples_per_period=SAMPLES_PER_PERIOD):
+    """Pseudo-spectral acceleration :math:`S_a(T)` [m/s^2] (see :func:`response_spectrum`,
+    which also says how short periods are oversampled).
 
     Parameters
     ----------
@@ -655,13 +715,15 @@ def spectral_acceleration(acc, dt, periods, damping=DEFAULT_DAMPING):
         Natural period(s) [s], ``>= 0``; ``0`` gives PGA.
     damping : float
         Fraction of critical damping in [0, 1) [-]; default 0.05.
+    samples_per_period : int
+        Fewest response samples per oscillator period [-]; see :func:`response_spectrum`.
 
     Returns
     -------
     float or numpy.ndarray
         :math:`S_a` [m/s^2]; a float when ``periods`` is a scalar.
     """
-    psa = response_spectrum(acc, dt, periods, damping).psa
+    psa = response_spectrum(acc, dt, periods, damping, samples_per_period).psa
     return float(psa[0]) if np.ndim(periods) == 0 else psa
 
 
@@ -692,7 +754,9 @@ def intensity_measures(acc, dt, periods=DEFAULT_PERIODS, damping=DEFAULT_DAMPING
     """
     a = _as_record(acc)
     dt = _check_dt(dt)
-    p_a, p_v, p_d = pga(a, dt), pgv(a, dt), pgd(a, dt)
+    v = velocity(a, dt)
+    d = displacement(a, dt)
+    i_a, i_v, i_d = (int(np.argmax(np.abs(x))) for x in (a, v, d))
     if np.any(a != 0.0):
         d575 = significant_duration(a, dt, 0.05, 0.75)
         d595 = significant_duration(a, dt, 0.05, 0.95)
@@ -700,12 +764,12 @@ def intensity_measures(acc, dt, periods=DEFAULT_PERIODS, damping=DEFAULT_DAMPING
         d575 = d595 = float("nan")
     spec = response_spectrum(a, dt, periods, damping)
     return {
-        "pga": p_a.value,
-        "t_pga": p_a.time,
-        "pgv": p_v.value,
-        "t_pgv": p_v.time,
-        "pgd": p_d.value,
-        "t_pgd": p_d.time,
+        "pga": float(abs(a[i_a])),
+        "t_pga": i_a * dt,
+        "pgv": float(abs(v[i_v])),
+        "t_pgv": i_v * dt,
+        "pgd": float(abs(d[i_d])),
+        "t_pgd": i_d * dt,
         "arias": arias_intensity(a, dt),
         "cav": cav(a, dt),
         "cav5": cav5(a, dt),

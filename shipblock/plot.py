@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from shipblock.errors import ParameterError
 from shipblock.modes import MODE_DESCRIPTIONS
 from shipblock.units import STANDARD_GRAVITY
 
@@ -312,28 +313,108 @@ def plot_spectrum(acc, dt, periods=None, damping=0.05, ax=None, label=None, **li
 
 
 def _im_axis(ds, values):
-    """IM values for display: PGA/Sa in g, others as stored; returns (values, label)."""
-    coord = ds["im_level"] if "im_level" in ds.coords else ds.get("achieved_im")
-    attrs = coord.attrs if coord is not None else {}
-    units = attrs.get("units", "")
-    measure = str(attrs.get("measure", "im")).upper()
-    if units in ("m/s^2", "m/s**2") and measure in ("PGA", "SA", "IM"):
-        return np.asarray(values, float) / STANDARD_GRAVITY, f"{measure} [g]", STANDARD_GRAVITY
-    return np.asarray(values, float), f"{measure} [{units}]", 1.0
+    """IM values for display in the pipeline's unit (g for ``levels_g``): (values, label, factor)."""
+    from shipblock.fragility.report import display_units, im_label
+
+    unit, factor = display_units(ds)
+    return np.asarray(values, float) / factor, im_label(ds), factor
+
+
+def sweep_selection(ds, sweep=None) -> dict:
+    """The value of every swept parameter to draw: those named, the first of the others.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A result of :func:`shipblock.run_pipeline`.
+    sweep : dict, optional
+        Swept parameter -> value; a value is matched to the study's within 1e-9 relative.
+
+    Returns
+    -------
+    dict
+        Every swept parameter -> the study's value (as stored).
+
+    Raises
+    ------
+    ValueError
+        If a name is not a swept parameter of the study or a value is not one of its values
+        (the message lists them).
+    """
+    swept = [d for d in ds["median"].dims if d != "limit_state"] if "median" in ds else []
+    sweep = dict(sweep or {})
+    unknown = [k for k in sweep if k not in swept]
+    if unknown:
+        raise ParameterError(
+            f"{unknown[0]!r} is not a swept parameter of this study"
+            + (f"; swept: {', '.join(swept)}" if swept else " (it sweeps none)"))
+    out = {}
+    for dim in swept:
+        values = ds[dim].values
+        if dim not in sweep:
+            out[dim] = values[0]
+            continue
+        close = np.flatnonzero(np.isclose(values.astype(float), float(sweep[dim]), rtol=1e-9,
+                                          atol=0.0))
+        if close.size != 1:
+            raise ParameterError(f"{dim} = {sweep[dim]!r} is not a value of the study; values: "
+                                 f"{', '.join(f'{v:g}' for v in values)}")
+        out[dim] = values[close[0]]
+    return out
 
 
 def _select_sweep(da, sweep):
-    """Pick one value of every swept dimension (the first unless ``sweep`` names one)."""
-    sweep = dict(sweep or {})
+    """``da`` at one value of every swept dimension (``sweep`` from :func:`sweep_selection`)."""
+    sel = {dim: value for dim, value in (sweep or {}).items() if dim in da.dims}
+    da = da.sel(sel)
     for dim in list(da.dims):
-        if dim in ("record", "im_level", "limit_state"):
-            continue
-        da = da.sel({dim: sweep[dim]}) if dim in sweep else da.isel({dim: 0})
+        if dim not in ("record", "im_level", "limit_state"):
+            da = da.isel({dim: 0})
     return da
+
+
+def _sweep_text(sweep) -> str:
+    return ", ".join(f"{k} = {v:g}" if isinstance(v, float | int | np.number) else f"{k} = {v}"
+                     for k, v in (sweep or {}).items())
+
+
+_CONDITION_SYMBOLS = {"greater": ">", "greater_equal": ">=", "equal": "=", "nonzero": "!= 0"}
+
+
+def limit_state_text(ds, name) -> str:
+    """``"peak_ship_slip > 0.02 m"``: the definition of a limit state, for legends."""
+    if "limit_state_edp" not in ds.coords:
+        return str(name)
+    sel = ds.sel(limit_state=name)
+    edp = str(sel["limit_state_edp"].values)
+    condition = str(sel["limit_state_condition"].values)
+    threshold = float(sel["limit_state_threshold"].values)
+    symbol = _CONDITION_SYMBOLS.get(condition, condition)
+    if condition == "nonzero" or not np.isfinite(threshold):
+        return f"{edp} {symbol}"
+    units = ds[edp].attrs.get("units", "") if edp in ds else ""
+    units = "" if units in ("1", "") else f" {units}"
+    return f"{edp} {symbol} {threshold:g}{units}"
+
+
+#: Marker of each limit state's observed fractions (the curves are told apart by colour; the
+#: markers also where fractions coincide).
+_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "<", ">", "h")
+
+
+#: Sideways offset between the observed fractions of successive limit states, as a fraction
+#: of the IM axis [-].
+DODGE = 0.012
 
 
 def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
     """Fitted lognormal fragility curves with the observed fractions of exceedance.
+
+    The legend gives each limit state's definition (EDP, condition, threshold with its units)
+    and fit; the title the number of records per level and, for a sweep, the swept values
+    drawn. Observed fractions of different limit states that coincide (typically 0 and 1 at
+    the ends) are told apart by marker and drawn side by side: limit state ``i`` of ``n`` is
+    offset by ``(i - (n - 1)/2)`` times :data:`DODGE` of the axis (the curves are not moved).
 
     Parameters
     ----------
@@ -344,7 +425,8 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
         Limit states to draw (default all).
     ax : matplotlib Axes, optional
     sweep : dict, optional
-        Value of each swept parameter to draw (default: the first of each).
+        Value of each swept parameter to draw (default: the first of each;
+        :func:`sweep_selection`).
 
     Returns
     -------
@@ -355,6 +437,7 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
     if ax is None:
         _, axs = _new_axes(1, height=4.0)
         ax = axs[0]
+    sweep = sweep_selection(ds, sweep)
     names = list(ds["limit_state"].values)
     if limit_state is not None:
         names = [limit_state] if isinstance(limit_state, str) else list(limit_state)
@@ -364,16 +447,29 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
     x_max = 1.15 * float(np.nanmax(x_obs_si if scaled else ds["achieved_im"].values))
     x_si = np.linspace(x_max / 400, x_max, 400)
     x_plot, xlabel, _ = _im_axis(ds, x_si)
+    from matplotlib.lines import Line2D
+
+    from shipblock.fragility.report import display_units
+
     colours = [f"C{i}" for i in range(10)]
+    n_per_level = None
+    handles = []
     for i, name in enumerate(names):
         c = colours[i % 10]
+        marker = _MARKERS[i % len(_MARKERS)]
         median = float(_select_sweep(ds["median"].sel(limit_state=name), sweep))
         beta = float(_select_sweep(ds["beta"].sel(limit_state=name), sweep))
-        desc = name.replace("_", " ")
-        if np.isfinite(median) and np.isfinite(beta) and beta > 0:
+        desc = f"{name} ({limit_state_text(ds, name)})"
+        fitted = np.isfinite(median) and np.isfinite(beta) and beta > 0
+        if fitted:
             med_plot, _, _ = _im_axis(ds, [median])
-            ax.plot(x_plot, norm.cdf(np.log(x_si / median) / beta), color=c, lw=1.8,
-                    label=f"{desc}: median {med_plot[0]:.3g}, beta {beta:.2f}")
+            desc += f": median {med_plot[0]:.3g} {display_units(ds)[0]}, beta {beta:.2f}"
+        else:
+            desc += ": no fit"
+        handles.append(Line2D([], [], color=c, lw=1.8 if fitted else 0, marker=marker,
+                              mfc="white", mew=1.5, ms=5.5, label=desc))
+        if fitted:
+            ax.plot(x_plot, norm.cdf(np.log(x_si / median) / beta), color=c, lw=1.8)
             if "median_lower" in ds:
                 lo = float(_select_sweep(ds["median_lower"].sel(limit_state=name), sweep))
                 hi = float(_select_sweep(ds["median_upper"].sel(limit_state=name), sweep))
@@ -381,25 +477,112 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
                     ax.fill_between(x_plot, norm.cdf(np.log(x_si / hi) / beta),
                                     norm.cdf(np.log(x_si / lo) / beta), color=c, alpha=0.15,
                                     lw=0)
-        else:
-            ax.plot([], [], color=c, label=f"{desc}: no fit")
         if scaled:
             ex = _select_sweep(ds["exceeded"].sel(limit_state=name), sweep)
             ok = _select_sweep(ds["valid"].sel(limit_state=name), sweep)
             n_ex = (ex & ok).sum("record").values
             n = ok.sum("record").values
+            if n_per_level is None:
+                n_per_level = n
             frac = np.where(n > 0, n_ex / np.maximum(n, 1), np.nan)
             xo, _, _ = _im_axis(ds, x_obs_si)
-            ax.plot(xo, frac, "o", color=c, ms=5, mfc="white", mew=1.5)
+            # side by side at each level, a marker's width apart (about 1.2 % of the axis)
+            dodge = DODGE * x_plot[-1] * (i - (len(names) - 1) / 2)
+            ax.plot(xo + dodge, frac, marker, color=c, ms=5.5, mfc="white", mew=1.5, zorder=3)
     ax.set_xlabel(xlabel)
     ax.set_ylabel("probability of exceedance")
-    ax.set_ylim(-0.02, 1.02)
+    ax.set_ylim(-0.03, 1.03)
     ax.set_xlim(0, x_plot[-1])
     ax.grid(True, lw=0.3, alpha=0.5)
-    band = " (shaded: bootstrap band of the median)" if "median_lower" in ds else ""
-    ax.set_title("fragility: lognormal fit (lines), observed fractions (circles)" + band,
-                 fontsize=9)
-    ax.legend(fontsize=8, loc="lower right")
+    parts = []
+    if n_per_level is not None:
+        counts = np.unique(n_per_level)
+        parts.append(f"{int(counts[0])} records per level" if counts.size == 1 else
+                     "records per level: " + ", ".join(str(int(k)) for k in n_per_level))
+    elif not scaled:
+        parts.append(f"{int(ds['valid'].sel(limit_state=names[0]).pipe(_select_sweep, sweep).sum())}"
+                     " records")
+    if sweep:
+        parts.append(_sweep_text(sweep))
+    band = "; shaded: bootstrap band of the median" if "median_lower" in ds else ""
+    ax.set_title("fragility: lognormal fit (lines), observed fractions (markers)" + band
+                 + ("\n" + "; ".join(parts) if parts else ""), fontsize=9)
+    ax.legend(handles=handles, fontsize=7.5, loc="best")
+    return ax
+
+
+def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None):
+    """Fitted median against a swept parameter, with its bootstrap band, per limit state.
+
+    Limit states are drawn side by side (offset by :data:`DODGE` of the parameter's range), so
+    that equal medians stay visible; the legend names the values where a fit failed.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Result of :func:`shipblock.run_pipeline` of a study with a ``[sweep]``.
+    parameter : str, optional
+        The swept parameter on the x axis (default: the first).
+    limit_state : str or sequence of str, optional
+        Limit states to draw (default all).
+    ax : matplotlib Axes, optional
+    sweep : dict, optional
+        Values of the other swept parameters (default: the first of each); named in the title.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Raises
+    ------
+    ValueError
+        If the study sweeps nothing or ``parameter`` is not swept.
+    """
+    swept = [d for d in ds["median"].dims if d != "limit_state"]
+    if not swept:
+        raise ParameterError("the study sweeps no parameter: nothing to draw the median against")
+    parameter = parameter or swept[0]
+    if parameter not in swept:
+        raise ParameterError(f"{parameter!r} is not a swept parameter; swept: {', '.join(swept)}")
+    others = sweep_selection(ds, {k: v for k, v in (sweep or {}).items() if k != parameter})
+    others.pop(parameter, None)
+    if ax is None:
+        _, axs = _new_axes(1, height=3.6)
+        ax = axs[0]
+    names = list(ds["limit_state"].values)
+    if limit_state is not None:
+        names = [limit_state] if isinstance(limit_state, str) else list(limit_state)
+    x = ds[parameter].values.astype(float)
+    span = float(np.ptp(x)) or 1.0
+    _, ylabel, factor = _im_axis(ds, [])
+    for i, name in enumerate(names):
+        c = f"C{i % 10}"
+        # limit states with equal medians side by side, as in plot_fragility
+        xd = x + DODGE * span * (i - (len(names) - 1) / 2)
+        med = ds["median"].sel(limit_state=name).sel(others).values / factor
+        label = f"{name} ({limit_state_text(ds, name)})"
+        missing = [f"{v:g}" for v, m in zip(x, med, strict=True) if not np.isfinite(m)]
+        if missing:
+            label += f"; not fitted at {parameter} = {', '.join(missing)}"
+        ax.plot(xd, med, "-" + _MARKERS[i % len(_MARKERS)], color=c, lw=1.5, ms=5,
+                mfc="white", mew=1.5, label=label)
+        if "median_lower" in ds:
+            lo = ds["median_lower"].sel(limit_state=name).sel(others).values / factor
+            hi = ds["median_upper"].sel(limit_state=name).sel(others).values / factor
+            ax.errorbar(xd, med, yerr=[med - lo, hi - med], fmt="none", ecolor=c, elinewidth=1,
+                        capsize=3)
+    units = ds[parameter].attrs.get("units", "")
+    long_name = ds[parameter].attrs.get("long_name", "").replace("swept parameter: ", "")
+    ax.set_xlabel(f"{parameter} [{units if units not in ('', '1') else '-'}]"
+                  + (f": {long_name}" if long_name else ""))
+    ax.set_ylabel(f"median {ylabel}")
+    ax.grid(True, lw=0.3, alpha=0.5)
+    band = " (bars: bootstrap band)" if "median_lower" in ds else ""
+    title = f"fitted median against {parameter}{band}"
+    if others:
+        title += "\n" + _sweep_text(others)
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=7.5)
     return ax
 
 
@@ -408,6 +591,16 @@ def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
 
     Runs that failed (separation, overturning) are marked with a cross at the right edge.
 
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Result of :func:`shipblock.run_pipeline` of an IDA or MSA study.
+    edp : str
+        The demand on the x axis.
+    ax : matplotlib Axes, optional
+    sweep : dict, optional
+        Value of each swept parameter to draw (default: the first of each); named in the title.
+
     Returns
     -------
     matplotlib.axes.Axes
@@ -415,6 +608,7 @@ def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
     if ax is None:
         _, axs = _new_axes(1, height=4.0)
         ax = axs[0]
+    sweep = sweep_selection(ds, sweep)
     demand = _select_sweep(ds[edp], sweep)
     failure = _select_sweep(ds["failure"], sweep) if "failure" in ds else None
     im_si = ds["achieved_im"].values
@@ -433,6 +627,7 @@ def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
     ax.set_xlabel(f"{ds[edp].attrs.get('long_name', edp)} [{unit_label}]")
     ax.set_ylabel(ylabel)
     ax.grid(True, lw=0.3, alpha=0.5)
-    ax.set_title("IDA curves (x: failure)", fontsize=9)
+    ax.set_title("IDA curves (x: failure)" + (f"; {_sweep_text(sweep)}" if sweep else ""),
+                 fontsize=9)
     ax.legend(fontsize=8, ncol=2)
     return ax

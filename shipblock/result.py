@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -163,6 +164,19 @@ class SimulationResult:
         """The events of one kind (for example ``"impact"``)."""
         return [e for e in self.events if e.kind == kind]
 
+    @cached_property
+    def forces(self):
+        """Interface forces per block at the samples (:class:`shipblock.loads.InterfaceForces`).
+
+        Computed on first use from the stored state and input; their peaks between the samples
+        are in :attr:`summary` (``peak_ground_normal_force`` ..., :mod:`shipblock.loads`).
+        """
+        from shipblock.loads import interface_forces
+
+        ax, ay = self.ground_acceleration
+        return interface_forces(self.system, self.mode, self.theta, self.theta_dot, self.v_b,
+                                self.v_s, ax, ay)
+
     def to_dataset(self):
         """The result as an :class:`xarray.Dataset` with units and long names.
 
@@ -197,6 +211,7 @@ class SimulationResult:
                 "potential_energy": var(self.energy.potential, "J", "gravity potential energy"),
                 "friction_dissipation": var(self.energy.friction, "J", "energy dissipated by friction"),
                 "impact_loss": var(self.energy.impact, "J", "kinetic energy lost in impacts"),
+                **self._force_variables(var),
                 "event_time": var(np.array([e.time for e in events], dtype=float), "s",
                                   "event time", ("event",)),
                 "event_kind": var(np.array([e.kind for e in events], dtype=str), "1",
@@ -225,6 +240,25 @@ class SimulationResult:
         for key, value in self.options.items():
             ds.attrs[f"solver_{key}"] = value
         return ds
+
+
+    def _force_variables(self, var) -> dict:
+        """The interface forces per block as dataset variables (see :attr:`forces`)."""
+        f = self.forces
+        return {
+            "ground_normal_force": var(f.ground_normal, "N",
+                                       "normal force of the dock floor on one block"),
+            "ground_friction_force": var(f.ground_friction, "N", "friction force of the dock "
+                                                                  "floor on one block, positive "
+                                                                  "to the right"),
+            "ship_normal_force": var(f.ship_normal, "N", "normal force of one block on the ship"),
+            "ship_friction_force": var(f.ship_friction, "N", "friction force of one block on "
+                                                              "the ship, positive to the right"),
+            "ground_friction_utilisation": var(f.ground_utilisation, "1",
+                                               "|f_x| / (mu_s f_y), blocks on the floor"),
+            "ship_friction_utilisation": var(f.ship_utilisation, "1",
+                                             "|F_x| / (mu_s F_y), ship on the blocks"),
+        }
 
 
 _KIND_NAMES = {k.value: k.name.lower() for k in EventKind}

@@ -16,6 +16,13 @@ scaled to its own target or factor (``"independent"``), left as recorded (``"uns
 removed (``"zero"``). Polarity reversal multiplies a component by -1 and is reported as a
 negative factor, so that always ``scaled = factor * original``.
 
+Records can also be scaled to a *target spectrum* over a period range, as ASCE 7 and PEER
+practice do (:func:`spectrum_match`): the factor minimising the squared differences of
+:math:`\ln S_a` over :math:`[T_a, T_b]` (least squares in log spectral acceleration), or the
+factor that matches :math:`S_a(T_1)` exactly with the misfit over the range reported. The
+target comes from a two-column file of periods and spectral accelerations
+(:func:`read_target_spectrum`).
+
 All inputs and outputs are SI: accelerations [m/s^2], velocities [m/s], displacements [m],
 periods [s].
 """
@@ -23,22 +30,28 @@ periods [s].
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from shipblock import checks, intensity
-from shipblock.errors import ParameterError, ParameterTypeError, RecordError
-from shipblock.units import STANDARD_GRAVITY
+from shipblock.errors import ParameterError, ParameterTypeError, RecordError, ShipblockError
+from shipblock.units import STANDARD_GRAVITY, acceleration_to_si
 
 __all__ = [
+    "MATCH_MODES",
     "MEASURES",
     "VERTICAL_MODES",
     "ScaledRecord",
+    "SpectrumMatch",
+    "TargetSpectrum",
     "amplitude_factor",
     "measure_value",
+    "read_target_spectrum",
     "scale",
     "scale_motion",
     "scale_record",
+    "spectrum_match",
 ]
 
 #: Scaling measures: name -> (description with unit, homogeneity degree p [-]).
@@ -166,11 +179,11 @@ def measure_value(acc, dt, measure="pga", period=None, damping=intensity.DEFAULT
     """
     period, damping = _check_measure(measure, period, damping)
     if measure == "pga":
-        return intensity.pga(acc, dt).value
+        return intensity.pga(acc, dt)
     if measure == "pgv":
-        return intensity.pgv(acc, dt).value
+        return intensity.pgv(acc, dt)
     if measure == "pgd":
-        return intensity.pgd(acc, dt).value
+        return intensity.pgd(acc, dt)
     if measure == "sa":
         return intensity.spectral_acceleration(acc, dt, period, damping)
     if measure == "cav":
@@ -449,3 +462,246 @@ def scale_motion(motion, **options):
         tr.data = factor * np.asarray(tr.data, dtype=np.float64)
         tr.stats.processing = [*tr.stats.get("processing", []), entry]
     return motion.with_stream(stream, entry), result
+
+
+# --------------------------------------------------------------------------------------------
+# scaling to a target spectrum
+# --------------------------------------------------------------------------------------------
+
+#: How :func:`spectrum_match` sets the factor: least squares in ln Sa over the period range, or
+#: Sa(T1) matched exactly (the misfit over the range reported).
+MATCH_MODES = ("range", "anchor")
+
+#: Periods of the matching grid, log-spaced over the range [-].
+DEFAULT_MATCH_PERIODS = 40
+
+
+class TargetSpectrumError(ShipblockError, ValueError):
+    """A target spectrum file cannot be used; the message names the file and the line."""
+
+
+@dataclass(frozen=True)
+class TargetSpectrum:
+    """A target pseudo-spectral acceleration spectrum, interpolated log-log.
+
+    Attributes
+    ----------
+    periods : numpy.ndarray
+        Periods [s], positive and strictly increasing.
+    sa : numpy.ndarray
+        Spectral accelerations [m/s^2], positive.
+    source : str
+        Where it came from (file name), for messages and provenance.
+    """
+
+    periods: np.ndarray
+    sa: np.ndarray
+    source: str = "<array>"
+
+    def __post_init__(self):
+        t = np.asarray(self.periods, dtype=float)
+        sa = np.asarray(self.sa, dtype=float)
+        if t.ndim != 1 or sa.shape != t.shape or t.size < 2:
+            raise TargetSpectrumError(f"{self.source}: a target spectrum needs at least two "
+                                      f"(period, Sa) pairs of equal length, got {t.shape} and "
+                                      f"{sa.shape}")
+        if not (np.all(np.isfinite(t)) and np.all(t > 0) and np.all(np.diff(t) > 0)):
+            raise TargetSpectrumError(f"{self.source}: periods must be positive and strictly "
+                                      "increasing [s]")
+        if not (np.all(np.isfinite(sa)) and np.all(sa > 0)):
+            raise TargetSpectrumError(f"{self.source}: spectral accelerations must be positive")
+        object.__setattr__(self, "periods", t)
+        object.__setattr__(self, "sa", sa)
+
+    def at(self, periods) -> np.ndarray:
+        """The target at ``periods`` [s], interpolated linearly in (ln T, ln Sa) [m/s^2].
+
+        Raises
+        ------
+        TargetSpectrumError
+            For a period outside the target's range (no extrapolation).
+        """
+        t = np.atleast_1d(np.asarray(periods, dtype=float))
+        lo, hi = self.periods[0], self.periods[-1]
+        if np.any(t < lo * (1 - 1e-12)) or np.any(t > hi * (1 + 1e-12)):
+            raise TargetSpectrumError(
+                f"{self.source}: the target spectrum covers {lo:g} to {hi:g} s; periods "
+                f"{t.min():g} to {t.max():g} s are needed")
+        t = np.clip(t, lo, hi)
+        return np.exp(np.interp(np.log(t), np.log(self.periods), np.log(self.sa)))
+
+
+def read_target_spectrum(path, units) -> TargetSpectrum:
+    """Read a target spectrum: two columns, period [s] and Sa in ``units``.
+
+    Columns are separated by commas, semicolons or white space; lines starting with ``#`` and
+    a first line of column names are skipped.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    units : str
+        Unit of the Sa column: ``"g"``, ``"m/s^2"``, ``"cm/s^2"``, ... (any unit of
+        :func:`shipblock.units.acceleration_to_si`). Required: a file of numbers does not say.
+
+    Returns
+    -------
+    TargetSpectrum
+        Periods [s] and Sa [m/s^2].
+
+    Raises
+    ------
+    TargetSpectrumError
+        Naming the file and line: missing file, a line that is not two numbers, periods not
+        increasing, non-positive values, an unknown unit.
+    """
+    path = Path(path)
+    try:
+        factor = float(acceleration_to_si(1.0, units))
+    except ValueError as exc:
+        raise TargetSpectrumError(f"{path}: {exc}") from None
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise TargetSpectrumError(f"{path}: cannot read the target spectrum ({exc})") from None
+    rows = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        stripped = line.split("#", 1)[0].strip()
+        if not stripped:
+            continue
+        fields = stripped.replace(",", " ").replace(";", " ").split()
+        try:
+            values = [float(f) for f in fields]
+        except ValueError:
+            if not rows and number == _first_content_line(text):
+                continue  # a header of column names
+            raise TargetSpectrumError(f"{path}, line {number}: expected two numbers (period [s],"
+                                      f" Sa [{units}]), got {line.strip()!r}") from None
+        if len(values) != 2:
+            raise TargetSpectrumError(f"{path}, line {number}: expected two columns (period [s],"
+                                      f" Sa [{units}]), got {len(values)}")
+        rows.append(values)
+    if not rows:
+        raise TargetSpectrumError(f"{path}: no (period, Sa) rows")
+    data = np.array(rows, dtype=float)
+    return TargetSpectrum(data[:, 0], data[:, 1] * factor, source=str(path))
+
+
+def _first_content_line(text: str) -> int:
+    for number, line in enumerate(text.splitlines(), start=1):
+        if line.split("#", 1)[0].strip():
+            return number
+    return 0
+
+
+@dataclass(frozen=True)
+class SpectrumMatch:
+    r"""Result of :func:`spectrum_match`.
+
+    Attributes
+    ----------
+    factor : float
+        Scale factor of the record [-], > 0.
+    misfit : float
+        RMS of :math:`\ln(f S_a^{rec}(T_i) / S_a^{target}(T_i))` over the matching periods [-]
+        (0.1 is about 10 % off on average).
+    periods : numpy.ndarray
+        The matching periods [s], log-spaced over the range.
+    sa_record : numpy.ndarray
+        Pseudo-spectral acceleration of the *unscaled* record there [m/s^2].
+    sa_target : numpy.ndarray
+        The target there [m/s^2].
+    """
+
+    factor: float
+    misfit: float
+    periods: np.ndarray
+    sa_record: np.ndarray
+    sa_target: np.ndarray
+
+
+def spectrum_match(acc, dt, target: TargetSpectrum, period_range, *, mode="range",
+                   anchor_period=None, damping=intensity.DEFAULT_DAMPING,
+                   n_periods=DEFAULT_MATCH_PERIODS) -> SpectrumMatch:
+    r"""Scale factor of a record to a target spectrum over a period range, and its misfit.
+
+    On ``n_periods`` periods :math:`T_i` log-spaced over :math:`[T_a, T_b]`:
+
+    * ``mode="range"``: least squares in :math:`\ln S_a`, as the PEER ground-motion database
+      scales records (the mean squared error of :math:`\ln S_a` over the range minimised,
+      equal weights; Ancheta et al. 2013 [1]_), over a range such as ASCE 7-16 chapter 16's
+      :math:`0.2\,T` to :math:`2\,T` [2]_,
+
+      .. math:: \ln f = \frac{1}{n}\sum_i \ln\frac{S_a^{target}(T_i)}{S_a^{rec}(T_i)};
+
+    * ``mode="anchor"``: the spectrum conditional on :math:`S_a(T_1)`, matched there exactly,
+      :math:`f = S_a^{target}(T_1)/S_a^{rec}(T_1)`, the rest of the range only reported.
+
+    Either way the misfit is the RMS of the log residuals,
+    :math:`\sqrt{\frac1n \sum_i \ln^2(f S_a^{rec}(T_i)/S_a^{target}(T_i))}`.
+
+    Parameters
+    ----------
+    acc : array_like
+        Horizontal acceleration [m/s^2].
+    dt : float
+        Time step [s].
+    target : TargetSpectrum
+        The target [m/s^2]; it must cover the range (and ``anchor_period``).
+    period_range : tuple of float
+        :math:`(T_a, T_b)` [s], ``0 < T_a < T_b``.
+    mode : {"range", "anchor"}
+        See above.
+    anchor_period : float, optional
+        :math:`T_1` [s], required for ``"anchor"``.
+    damping : float
+        Fraction of critical damping of the spectra [-].
+    n_periods : int
+        Number of matching periods [-], >= 2.
+
+    Returns
+    -------
+    SpectrumMatch
+
+    Raises
+    ------
+    ValueError
+        For a bad range, mode, anchor or a target that does not cover them.
+    shipblock.errors.RecordError
+        For a record with zero spectral acceleration in the range.
+
+    References
+    ----------
+    .. [1] Ancheta, T. D. et al. (2013). PEER NGA-West2 database. PEER Report 2013/03, Pacific
+       Earthquake Engineering Research Center (record scaling by minimum MSE of ln Sa).
+    .. [2] ASCE/SEI 7-16 (2017). *Minimum Design Loads and Associated Criteria for Buildings
+       and Other Structures*, chapter 16 (amplitude scaling over a period range).
+    """
+    if mode not in MATCH_MODES:
+        raise ParameterError(f"mode must be one of {MATCH_MODES}, got {mode!r}")
+    try:
+        ta, tb = (float(x) for x in period_range)
+    except (TypeError, ValueError):
+        raise ParameterError(f"period_range must be two periods [s], got {period_range!r}") from None
+    if not (0 < ta < tb and np.isfinite(tb)):
+        raise ParameterError(f"period_range must satisfy 0 < T_a < T_b [s], got {period_range!r}")
+    if int(n_periods) != n_periods or n_periods < 2:
+        raise ParameterError(f"n_periods must be a whole number >= 2, got {n_periods!r}")
+    periods = np.geomspace(ta, tb, int(n_periods))
+    sa_t = target.at(periods)
+    sa_r = intensity.spectral_acceleration(acc, dt, periods, damping)
+    if not np.all(sa_r > 0):
+        raise RecordError("<horizontal>", f"has zero Sa between {ta:g} and {tb:g} s")
+    if mode == "range":
+        factor = float(np.exp(np.mean(np.log(sa_t / sa_r))))
+    else:
+        if anchor_period is None:
+            raise ParameterError("mode 'anchor' needs anchor_period [s] (T1)")
+        t1 = float(anchor_period)
+        sa_r1 = intensity.spectral_acceleration(acc, dt, t1, damping)
+        if not sa_r1 > 0:
+            raise RecordError("<horizontal>", f"has zero Sa at T1 = {t1:g} s")
+        factor = float(target.at(t1)[0] / sa_r1)
+    misfit = float(np.sqrt(np.mean(np.log(factor * sa_r / sa_t) ** 2)))
+    return SpectrumMatch(factor, misfit, periods, sa_r, sa_t)

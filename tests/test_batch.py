@@ -160,8 +160,8 @@ def test_intensity_design_validation(bad, match):
 @pytest.mark.parametrize(
     ("measure", "levels", "period", "measure_fn"),
     [
-        ("pga", (0.5, 2.0, 4.0), None, lambda a, dt: intensity.pga(a, dt).value),
-        ("pgv", (0.1, 0.3), None, lambda a, dt: intensity.pgv(a, dt).value),
+        ("pga", (0.5, 2.0, 4.0), None, lambda a, dt: intensity.pga(a, dt)),
+        ("pgv", (0.1, 0.3), None, lambda a, dt: intensity.pgv(a, dt)),
         ("sa", (1.0, 5.0), 0.5, lambda a, dt: intensity.spectral_acceleration(a, dt, 0.5)),
     ],
 )
@@ -187,7 +187,7 @@ def test_vertical_modes():
     ind = prepare_record("s", _loader(1), [], IntensityDesign(
         "ida", levels=lv, vertical="independent", vertical_levels=(1.0, 2.0)))
     for j, target in enumerate((1.0, 2.0)):
-        assert intensity.pga(ind.factor_v[j] * ind.vertical, ind.dt).value == pytest.approx(target)
+        assert intensity.pga(ind.factor_v[j] * ind.vertical, ind.dt) == pytest.approx(target)
     none = prepare_record("s", _loader(1, vertical=False), [], IntensityDesign("ida", levels=lv))
     assert none.vertical is None and np.all(np.isnan(none.factor_v))
 

@@ -178,6 +178,7 @@ def test_history_command_prints_writes_and_draws(history_run, tmp_path, capsys):
     out = capsys.readouterr().out
     assert code == 0, out
     assert "syn/S2" in out and "peak ship slip" in out
+    assert "syn/S2 at PGA 0.5 g, scale factor" in out  # the pipeline's unit, not m/s^2
     assert out_nc.exists() and out_nc.with_suffix(".png").exists()
     with xr.open_dataset(out_nc) as h:
         run = ds.sel(record="syn/S2", im_level=0.5 * G)

@@ -45,12 +45,10 @@ def test_velocity_displacement_of_sine():
     np.testing.assert_allclose(im.velocity(a, dt), v_exact, rtol=0, atol=1e-5 * amp / w)
     np.testing.assert_allclose(im.displacement(a, dt), d_exact, rtol=1e-5, atol=1e-5 * amp / w**2)
 
-    peak_v = im.pgv(a, dt)
-    assert peak_v.value == pytest.approx(2 * amp / w, rel=1e-5)
-    assert peak_v.time == pytest.approx(np.pi / w, abs=dt)
-    peak_d = im.pgd(a, dt)
-    assert peak_d.value == pytest.approx(amp * t[-1] / w, rel=1e-5)
-    assert peak_d.time == pytest.approx(t[-1])
+    assert im.pgv(a, dt) == pytest.approx(2 * amp / w, rel=1e-5)
+    assert im.peak_time(a, dt, "pgv") == pytest.approx(np.pi / w, abs=dt)
+    assert im.pgd(a, dt) == pytest.approx(amp * t[-1] / w, rel=1e-5)
+    assert im.peak_time(a, dt, "pgd") == pytest.approx(t[-1])
 
 
 def test_integration_exact_for_linear_acceleration():
@@ -68,8 +66,20 @@ def test_integration_exact_for_linear_acceleration():
 def test_pga_value_and_time_negative_peak():
     """PGA is the largest absolute value; its time is index * dt (definition)."""
     a = np.array([0.0, 1.0, -4.0, 2.0, 3.9])
-    peak = im.pga(a, 0.5)
-    assert peak == (4.0, 1.0)
+    assert im.pga(a, 0.5) == 4.0
+    assert im.peak_time(a, 0.5, "pga") == 1.0
+
+
+def test_peak_measures_are_plain_numbers_that_scale():
+    """A peak is one float, not a (value, time) pair: it multiplies and compares as a number
+    (a tuple would be repeated by 2 * ..., and its time would be scaled along with it)."""
+    a = np.array([0.0, 1.0, -4.0, 2.0])
+    for measure in (im.pga, im.pgv, im.pgd):
+        value = measure(a, 0.1)
+        assert type(value) is float
+        assert 2 * value == measure(2 * a, 0.1)
+    with pytest.raises(ValueError, match="measure"):
+        im.peak_time(a, 0.1, "sa")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -143,8 +153,52 @@ def test_nigam_jennings_matches_first_order_hold(period, damping):
     u_ref = _lsim(acc, dt, period, damping)
     u, _ = im.sdof_response(acc, dt, period, damping)
     np.testing.assert_allclose(u, u_ref, rtol=0, atol=1e-10 * np.max(np.abs(u_ref)))
-    spec = im.response_spectrum(acc, dt, [period], damping)
+    spec = im.response_spectrum(acc, dt, [period], damping, samples_per_period=1)
     assert spec.sd[0] == pytest.approx(np.max(np.abs(u_ref)), rel=1e-10)
+    # oversampled: the peak of the same piecewise-linear input's response on a grid of at
+    # least 100 points per period (lsim on the linearly interpolated record)
+    k = int(np.ceil(im.SAMPLES_PER_PERIOD * dt / period))
+    fine = np.interp(np.arange((acc.size - 1) * k + 1) / k, np.arange(acc.size), acc)
+    peak_fine = np.max(np.abs(_lsim(fine, dt / k, period, damping)))
+    spec = im.response_spectrum(acc, dt, [period], damping)
+    assert spec.sd[0] == pytest.approx(peak_fine, rel=1e-8)
+
+
+@pytest.mark.parametrize(("phase", "plain_error"), [(0.0, 0.0), (np.pi / 20, 0.0123)])
+def test_short_period_sa_is_oversampled_against_the_closed_form_harmonic_response(phase,
+                                                                                   plain_error):
+    """Resonant harmonic input a = A sin(w t + phase) on an oscillator of T = 20 dt.
+
+    Steady state (Chopra 2017, eq. 3.2.3, r = 1): Sa = A / (2 zeta), times sinc^2(pi dt / T)
+    for the piecewise-linear interpolation of the sampled sine (the interpolant's fundamental).
+    With the crests on samples (phase 0) the response at the samples reaches the peak; with
+    them half a sample off (phase = pi/20) it misses 1 - cos(pi/20) = 1.23 % without
+    oversampling and at most 1 - cos(pi/100) = 0.05 % with the default 100 samples per period.
+    """
+    dt, zeta, amp = 0.01, 0.05, 1.3
+    period = 20 * dt
+    w = 2 * np.pi / period
+    t = np.arange(int(60 * period / dt)) * dt  # transient decayed to exp(-18.8)
+    a = amp * np.sin(w * t + phase)
+    x = np.pi * dt / period
+    exact = amp / (2 * zeta) * (np.sin(x) / x) ** 2
+    plain = im.spectral_acceleration(a, dt, period, zeta, samples_per_period=1)
+    assert plain / exact - 1 == pytest.approx(-plain_error, abs=2e-4)
+    sa = im.spectral_acceleration(a, dt, period, zeta)
+    assert abs(sa / exact - 1) < 1 - np.cos(np.pi / im.SAMPLES_PER_PERIOD) + 1e-6
+    assert abs(sa / exact - 1) < 6e-4
+
+
+def test_long_periods_are_not_oversampled():
+    """At T >= 100 dt the oversampling is off: bit for bit the plain recursion."""
+    rng = np.random.default_rng(8)
+    acc = rng.standard_normal(3000)
+    periods = [1.0, 2.5]
+    np.testing.assert_array_equal(im.spectral_acceleration(acc, 0.01, periods),
+                                  im.spectral_acceleration(acc, 0.01, periods,
+                                                           samples_per_period=1))
+    with pytest.raises(ValueError, match="samples_per_period"):
+        im.response_spectrum(acc, 0.01, periods, samples_per_period=0)
 
 
 @pytest.mark.parametrize("damping", [0.0, 0.05, 0.2])
@@ -231,7 +285,7 @@ def test_sa_at_zero_period_is_pga_and_short_period_limit():
     """Sa(T = 0) = PGA by definition; Sa(T -> 0) -> PGA (rigid oscillator follows the ground)."""
     t = np.arange(3000) * 0.01
     a = np.sin(2 * np.pi * 0.7 * t) * np.exp(-(((t - 12) / 4) ** 2)) * 3.0
-    pga = im.pga(a, 0.01).value
+    pga = im.pga(a, 0.01)
     assert im.spectral_acceleration(a, 0.01, 0.0) == pga
     sa = im.spectral_acceleration(a, 0.01, [0.0, 1e-3, 1e-4])
     np.testing.assert_allclose(sa, pga, rtol=1e-3)
@@ -270,7 +324,7 @@ def test_spectrum_speed():
 def test_intensity_measures_dict_consistent():
     t, a, dt = _sine(2.0, 1.0, n_periods=3, samples_per_period=400)
     out = im.intensity_measures(a, dt, periods=(0.0, 0.5))
-    assert out["pga"] == im.pga(a, dt).value
+    assert out["pga"] == im.pga(a, dt)
     assert out["arias"] == im.arias_intensity(a, dt)
     assert out["cav"] == im.cav(a, dt)
     assert out["d5_95"] == im.significant_duration(a, dt)

@@ -146,8 +146,20 @@ def test_every_documented_summary_variable_except_failure_time_is_an_edp():
         "uplift",
         "n_impacts",
         "failure",
+        # contact loads per block (shipblock.loads)
+        "peak_ground_normal_force",
+        "peak_ground_friction_force",
+        "peak_ship_normal_force",
+        "peak_ship_friction_force",
+        "peak_ground_friction_utilisation",
+        "peak_ship_friction_utilisation",
+        "peak_corner_load",
     }
     assert set(EDP_VARIABLES) == expected
+    # every EDP is a summary variable of the solver
+    from shipblock.solver import SUMMARY_FIELDS
+
+    assert set(EDP_VARIABLES) - {"peak_rotation_ratio"} <= set(SUMMARY_FIELDS)
 
 
 # ---------------------------------------------------------------------------------------------

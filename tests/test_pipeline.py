@@ -22,7 +22,13 @@ import xarray as xr
 import shipblock
 from shipblock import simulate
 from shipblock.catalogue import load_catalogue
-from shipblock.fragility.pipeline import PipelineError, load_pipeline, run_pipeline
+from shipblock.fragility.fit import fit_ida
+from shipblock.fragility.pipeline import (
+    PipelineError,
+    fragility_variables,
+    load_pipeline,
+    run_pipeline,
+)
 from shipblock.units import STANDARD_GRAVITY as G
 
 from .test_batch import make_catalogue
@@ -77,6 +83,9 @@ chunk_size = {chunk_size}
 """
 
 
+IDA_LEVELS_G = (0.2, 0.3, 0.4, 0.45, 0.5)
+
+
 def write_pipeline(tmp_path, *, ids='"all"', kind="ida", sweep="", chunk_size=4,
                    levels='levels_g = [0.2, 0.4, 0.5, 0.6, 0.8]', n_records=3, bad=False,
                    name="p.toml") -> Path:
@@ -99,7 +108,9 @@ def assert_same_results(a: xr.Dataset, b: xr.Dataset):
 @pytest.fixture(scope="module")
 def ida_run(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("ida")
-    path = write_pipeline(tmp)
+    # levels fine enough around the three records' capacities for the interval-censored fit
+    # to identify beta (their intervals do not all share a point)
+    path = write_pipeline(tmp, levels=f"levels_g = {list(IDA_LEVELS_G)}")
     ds = run_pipeline(path, progress=False)
     return tmp, path, ds
 
@@ -115,7 +126,7 @@ def test_ida_dataset_layout_and_fits(ida_run):
     assert not (tmp / "out" / "result.nc.partial").exists()  # removed after the final write
     assert ds.sizes == {"record": 3, "im_level": 5, "limit_state": 2}
     assert list(ds["record"].values) == ["syn/S0", "syn/S1", "syn/S2"]
-    np.testing.assert_allclose(ds["im_level"], np.array([0.2, 0.4, 0.5, 0.6, 0.8]) * G)
+    np.testing.assert_allclose(ds["im_level"], np.array(IDA_LEVELS_G) * G)
     assert ds["peak_ship_slip"].dims == ("record", "im_level")
     assert ds["exceeded"].dims == ("limit_state", "record", "im_level")
     # achieved IM equals the target level for every record
@@ -124,7 +135,7 @@ def test_ida_dataset_layout_and_fits(ida_run):
     # fitted median per limit state, in m/s^2, inside the analysed range
     median = ds["median"].sel(limit_state="ship_slip")
     assert ds["median"].attrs["units"] == "m/s^2"
-    assert 0.2 * G < float(median) < 0.8 * G
+    assert 0.2 * G < float(median) < 0.5 * G
     assert float(ds["beta"].sel(limit_state="ship_slip")) > 0
     # exceedance is consistent with the EDP and threshold
     expect = (ds["peak_ship_slip"] > 0.005) | (ds["failure"] != 0)
@@ -135,6 +146,39 @@ def test_ida_dataset_layout_and_fits(ida_run):
     assert '"step": "taper"' in ds.attrs["processing_chain"]
     assert "syn/S1" in ds.attrs["records_provenance"]
     assert '"ship_mass": 5000000.0' in ds.attrs["system"]
+    # IDA fitted on the capacity intervals (last level held, first failed] by default
+    assert str(ds["fit_method"].sel(limit_state="ship_slip").values) == "ida_interval"
+    lower = ds["ida_capacity_lower"].sel(limit_state="ship_slip")
+    upper = ds["ida_capacity"].sel(limit_state="ship_slip")
+    assert bool((lower < upper).all())
+    for rec in ds["record"].values:
+        ex = ds["exceeded"].sel(limit_state="ship_slip", record=rec).values
+        levels = ds["im_level"].values
+        first = levels[np.argmax(ex)] if ex.any() else np.inf
+        held = levels[:np.argmax(ex)] if ex.any() else levels
+        assert float(upper.sel(record=rec)) == first
+        assert float(lower.sel(record=rec)) == (held[-1] if held.size else 0.0)
+
+
+def test_first_exceedance_option_reproduces_the_old_estimate_and_old_names_are_refused(
+        ida_run):
+    tmp, path, ds = ida_run
+    text = path.read_text()
+    path = tmp / "first_exceedance.toml"
+    path.write_text(text.replace("[fit]", '[fit]\nida_method = "mle"'))
+    with pytest.raises(PipelineError, match="now named 'first_exceedance'") as info:
+        load_pipeline(path)
+    assert info.value.key == "fit.ida_method"
+    path.write_text(text.replace("[fit]", '[fit]\nida_method = "first_exceedance"'))
+    pipe = load_pipeline(path)
+    assert pipe.fit["ida_method"] == "first_exceedance"
+    # the option fits the first exceeding levels as capacities, right-censored at the top
+    out = fragility_variables(ds, pipe.design, pipe.limit_states, {**pipe.fit, "bootstrap": 0})
+    upper = ds["ida_capacity"].sel(limit_state="ship_slip").values
+    old = fit_ida(upper, censored_at=ds["im_level"].values[-1])
+    assert float(out["median"].values[0]) == old.median  # limit state 0 is ship_slip
+    assert str(out["fit_method"].values[0]) == "ida_first_exceedance"
+    assert old.median > float(ds["median"].sel(limit_state="ship_slip"))
 
 
 def test_runs_equal_single_simulate(ida_run):
@@ -194,6 +238,69 @@ def test_sweep_msa_and_error_record(tmp_path):
     slip = ds["peak_ship_slip"].sel(record="syn/S0", slenderness=0.4)
     assert (slip.sel(mu_ship=0.3) >= slip.sel(mu_ship=0.45)).all()
     assert set(ds["fit_method"].sel(limit_state="ship_slip").values.ravel()) <= {"mle", ""}
+    # the study says how many records it used, and why one was left out
+    assert ds.attrs["n_records_used"] == 3
+    assert ds.attrs["records_used"].startswith("3 of 4 records used, 1 left out: syn/BAD "
+                                               "(RecordError: ")
+    np.testing.assert_array_equal(ds["record_used"], [True, True, True, False])
+
+
+def test_strict_study_fails_instead_of_leaving_a_record_out(tmp_path):
+    path = write_pipeline(tmp_path, bad=True)
+    path.write_text(path.read_text().replace('horizontal = "H1"',
+                                             'horizontal = "H1"\nstrict = true'))
+    with pytest.raises(PipelineError, match=r"syn/BAD \(RecordError: ") as info:
+        run_pipeline(path, progress=False)
+    assert info.value.key == "records.strict"
+    out = tmp_path / "out"  # failed before any run: no result, no partial results
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_runs_above_the_scale_factor_limit_are_reported_or_refused(ida_run, tmp_path, caplog):
+    """max_scale_factor = 2.5 on the synthetic records (factors 1.3 to 3.7 over the levels):
+    'warn' runs them and says so; 'refuse' does not make them (NaN, run_error says why), the
+    other runs equal the warned study's bit for bit and the fit counts only them."""
+    tmp, path, full = ida_run
+    text = path.read_text()
+    factors = np.abs(full["scale_factor"].values)
+    expect = factors > 2.5
+    assert expect.any() and not expect.all()
+    out = {}
+    for policy in ("warn", "refuse"):
+        p = tmp / f"{policy}.toml"
+        p.write_text(text.replace('type = "ida"', f'type = "ida"\nmax_scale_factor = 2.5\n'
+                                                  f'scale_factor_policy = "{policy}"'))
+        caplog.clear()
+        out[policy] = run_pipeline(p, output=tmp_path / f"{policy}.nc", progress=False)
+        assert f"{int(expect.sum())} of 15 runs have a scale factor above max_scale_factor = " \
+               "2.5" in caplog.text
+        np.testing.assert_array_equal(out[policy]["scale_factor_above_limit"], expect)
+        assert out[policy].attrs["max_scale_factor"] == 2.5
+        assert out[policy].attrs["scale_factor_policy"] == policy
+    warn, refuse = out["warn"], out["refuse"]
+    np.testing.assert_array_equal(warn["peak_ship_slip"], full["peak_ship_slip"])
+    made = refuse["peak_ship_slip"].values
+    np.testing.assert_array_equal(made[~expect], full["peak_ship_slip"].values[~expect])
+    assert np.isnan(made[expect]).all()
+    errors = refuse["run_error"].values
+    assert all(e.startswith("not run: scale factor ") and e.endswith(
+        "above max_scale_factor 2.5") for e in errors[expect])
+    assert not any(errors[~expect])
+    assert not refuse["valid"].values[:, expect].any()
+    assert refuse.attrs["records_used"] == "3 of 3 records used"
+
+
+def test_fits_and_levels_are_also_kept_in_the_pipelines_units(ida_run):
+    """levels_g: the levels and medians are stored in g beside SI, and fit messages quote
+    the levels in g (no SI number beside a g level)."""
+    _, _, ds = ida_run
+    np.testing.assert_allclose(ds["im_level_g"], IDA_LEVELS_G, rtol=1e-15)
+    assert ds.attrs["im_display_units"] == "g"
+    for name in ("median", "median_lower", "median_upper"):
+        assert ds[f"{name}_g"].attrs["units"] == "g"
+        np.testing.assert_allclose(ds[f"{name}_g"], ds[name] / G, rtol=1e-15)
+    error = str(ds["fit_error"].sel(limit_state="any_failure").values)
+    assert error.endswith("highest level (0.5); analyse higher IM levels [IM in g]")
 
 
 def test_msa_with_a_record_set_per_stripe(tmp_path):
@@ -691,3 +798,75 @@ def test_dask_equals_local(ida_run, tmp_path):
     with local_dask_client() as client:
         remote = run_pipeline(path, output=tmp_path / "dask.nc", client=client, progress=False)
     assert_same_results(local, remote)
+
+
+# -------------------------------------------------------------------------------------------
+# scaling to a target spectrum
+# -------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("match", ["range", "anchor"])
+def test_msa_scaled_to_a_target_spectrum(tmp_path, match):
+    """Levels are Sa(1 s); the target file (in g) is anchored to each level at T1 = 1 s.
+
+    'range': each record's scaled spectrum is the least-squares fit, in ln Sa over 0.2-2 s, of
+    the anchored target (its log residuals average zero); 'anchor': Sa(T1) equals the level.
+    The misfit stored is the RMS of those residuals, smaller for 'range'; a run made again
+    alone gets the batch's factors (the same summary)."""
+    from shipblock.fragility.pipeline import rerun_case
+    from shipblock.scaling import read_target_spectrum
+
+    (tmp_path / "target.csv").write_text(
+        "period_s, sa_g\n0.05, 0.5\n0.2, 1.0\n0.6, 1.0\n2.0, 0.3\n4.0, 0.15\n")
+    levels = ('measure = "sa"\nperiod = 1.0\nlevels_g = [0.3, 0.6]\n'
+              '[design.target_spectrum]\nfile = "target.csv"\nunits = "g"\n'
+              f'period_range = [0.2, 2.0]\nmatch = "{match}"\n')
+    path = write_pipeline(tmp_path, kind="msa", levels=levels)
+    ds = run_pipeline(path, progress=False)
+    target = read_target_spectrum(tmp_path / "target.csv", "g")
+    periods = ds["spectrum_period"].values
+    np.testing.assert_allclose(periods, np.geomspace(0.2, 2.0, 40))
+    np.testing.assert_allclose(ds["target_sa"], target.at(periods), rtol=1e-15)
+    levels_si = ds["im_level"].values
+    for r in range(3):
+        for j, level in enumerate(levels_si):
+            f = float(ds["scale_factor"].isel(record=r, im_level=j))
+            anchored = target.at(periods) * level / target.at(1.0)[0]
+            resid = np.log(f * ds["record_sa"].isel(record=r).values / anchored)
+            if match == "range":
+                assert abs(resid.mean()) < 1e-12
+            else:
+                assert float(ds["achieved_im"].isel(record=r, im_level=j)) == pytest.approx(
+                    level, rel=1e-12)
+            assert float(ds["spectrum_misfit"].isel(record=r)) == pytest.approx(
+                np.sqrt(np.mean(resid**2)), rel=1e-10)
+    assert ds.attrs["target_spectrum_match"] == match
+    res = rerun_case(path, "S1", im_level_g=0.6)
+    assert res.summary["peak_ship_slip"] == float(
+        ds["peak_ship_slip"].sel(record="syn/S1").isel(im_level=1))
+
+
+def test_target_spectrum_keys_are_checked(tmp_path):
+    (tmp_path / "target.csv").write_text("0.5 1.0\n1.0 0.8\n")
+    base = 'measure = "sa"\nperiod = 1.0\nlevels_g = [0.3]\n[design.target_spectrum]\n'
+    cases = [
+        ('file = "target.csv"\nunits = "g"\nperiod_range = [0.2, 2.0]\n',
+         "design.target_spectrum.file", "covers 0.5 to 1 s"),
+        ('file = "target.csv"\nperiod_range = [0.6, 0.9]\n', "design.target_spectrum.units",
+         "missing"),
+        ('file = "target.csv"\nunits = "g"\nperiod_range = [0.9, 0.6]\n',
+         "design.target_spectrum.period_range", "0 < T_a < T_b"),
+        ('file = "target.csv"\nunits = "g"\nperiod_range = [0.6, 0.9]\nmatch = "best"\n',
+         "design.target_spectrum.match", "'range'"),
+    ]
+    for i, (table, key, needle) in enumerate(cases):
+        path = write_pipeline(tmp_path, kind="msa", levels=base + table, name=f"p{i}.toml")
+        with pytest.raises(PipelineError, match=needle) as info:
+            load_pipeline(path)
+        assert info.value.key == key
+    path = write_pipeline(tmp_path, kind="msa", name="pga.toml", levels=(
+        'levels_g = [0.3]\n[design.target_spectrum]\nfile = "target.csv"\nunits = "g"\n'
+        'period_range = [0.6, 0.9]\n'))
+    with pytest.raises(PipelineError, match="measure = 'sa'") as info:
+        load_pipeline(path)
+    assert info.value.key == "design.target_spectrum"

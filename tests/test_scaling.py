@@ -49,8 +49,8 @@ def test_target_reached(record, measure, period, target):
     np.testing.assert_array_equal(out.horizontal, out.factor_h * h)
     # default vertical mode keeps V/H
     assert out.factor_v == out.factor_h
-    assert im.pga(out.vertical, DT).value / im.pga(out.horizontal, DT).value == pytest.approx(
-        im.pga(v, DT).value / im.pga(h, DT).value, rel=1e-12
+    assert im.pga(out.vertical, DT) / im.pga(out.horizontal, DT) == pytest.approx(
+        im.pga(v, DT) / im.pga(h, DT), rel=1e-12
     )
     # inputs untouched
     np.testing.assert_array_equal(h, h_in)
@@ -62,7 +62,7 @@ def test_arias_factor_is_square_root(record):
     h, _ = record
     ia = im.arias_intensity(h, DT)
     assert amplitude_factor(h, DT, 2 * ia, "arias") == pytest.approx(np.sqrt(2), rel=1e-12)
-    assert amplitude_factor(h, DT, 2 * im.pga(h, DT).value, "pga") == pytest.approx(2.0)
+    assert amplitude_factor(h, DT, 2 * im.pga(h, DT), "pga") == pytest.approx(2.0)
 
 
 def test_scale_by_factor_and_reverse(record):
@@ -71,7 +71,7 @@ def test_scale_by_factor_and_reverse(record):
     assert out.factor_h == -1.5 and out.factor_v == 1.5
     np.testing.assert_array_equal(out.horizontal, -1.5 * h)
     np.testing.assert_array_equal(out.vertical, 1.5 * v)
-    assert out.achieved == pytest.approx(1.5 * im.pga(h, DT).value)
+    assert out.achieved == pytest.approx(1.5 * im.pga(h, DT))
     rev = scale_record(h, v, DT, reverse=True, reverse_vertical=True)
     np.testing.assert_array_equal(rev.horizontal, -h)
     np.testing.assert_array_equal(rev.vertical, -v)
@@ -96,7 +96,7 @@ def test_vertical_independent_target(record):
     out = scale_record(h, v, DT, target=3.0, vertical_mode="independent", vertical_factor=0.5)
     np.testing.assert_array_equal(out.vertical, 0.5 * v)
     out = scale_record(h, v, DT, target=3.0, vertical_mode="independent", vertical_target=2.0)
-    assert im.pga(out.vertical, DT).value == pytest.approx(2.0, rel=1e-12)
+    assert im.pga(out.vertical, DT) == pytest.approx(2.0, rel=1e-12)
 
 
 def test_vertical_unscaled_zero_and_absent(record):
@@ -176,9 +176,86 @@ def test_scale_motion_integration(record):
     h, v = record
     gm = GroundMotion.from_arrays(h, v, dt=DT)
     out, scaled = scale_motion(gm, target=4.0, reverse=True)
-    assert im.pga(out.horizontal, DT).value == pytest.approx(4.0, rel=1e-12)
+    assert im.pga(out.horizontal, DT) == pytest.approx(4.0, rel=1e-12)
     np.testing.assert_allclose(out.horizontal, scaled.horizontal, rtol=1e-15)
     np.testing.assert_allclose(out.vertical, scaled.vertical, rtol=1e-15)
     assert scaled.factor_h < 0
     np.testing.assert_array_equal(gm.horizontal, h)
     assert "scale_record(" in out.metadata["processing"][-1]
+
+
+# ---------------------------------------------------------------------------------------------
+# scaling to a target spectrum
+# ---------------------------------------------------------------------------------------------
+def _spectrum_record():
+    rng = np.random.default_rng(21)
+    t = np.arange(3000) * DT
+    return rng.standard_normal(t.size) * np.exp(-(((t - 10.0) / 4.0) ** 2))
+
+
+def test_read_target_spectrum_units_header_comments_and_errors(tmp_path):
+    from shipblock.scaling import TargetSpectrumError, read_target_spectrum
+
+    path = tmp_path / "target.csv"
+    path.write_text("# design spectrum\nperiod_s, sa_g\n0.1, 0.8\n1.0, 1.0  # plateau end\n"
+                    "4.0; 0.25\n")
+    spec = read_target_spectrum(path, "g")
+    np.testing.assert_array_equal(spec.periods, [0.1, 1.0, 4.0])
+    np.testing.assert_allclose(spec.sa, np.array([0.8, 1.0, 0.25]) * 9.80665, rtol=1e-15)
+    # log-log interpolation: Sa ~ 1/T between 1 and 4 s
+    assert spec.at(2.0)[0] == pytest.approx(0.5 * 9.80665, rel=1e-12)
+    with pytest.raises(TargetSpectrumError, match="covers 0.1 to 4 s"):
+        spec.at(5.0)
+    path.write_text("0.1 0.8\n0.5 x\n")
+    with pytest.raises(TargetSpectrumError, match=r"target.csv, line 2: expected two numbers"):
+        read_target_spectrum(path, "g")
+    path.write_text("0.5 0.8\n0.1 0.9\n")
+    with pytest.raises(TargetSpectrumError, match="strictly increasing"):
+        read_target_spectrum(path, "m/s^2")
+    with pytest.raises(TargetSpectrumError, match="unit"):
+        read_target_spectrum(path, "furlongs")
+
+
+def test_spectrum_match_is_least_squares_in_ln_sa_and_reports_the_rms_misfit():
+    """Target = c Sa_rec(T) exp(e(T)): the least-squares factor is c exp(mean e) (normal
+    equation of ln Sa_target - ln f - ln Sa_rec), the misfit the RMS of e - mean e; checked
+    against a numerical minimisation of the same sum of squares."""
+    from scipy import optimize
+
+    from shipblock.scaling import TargetSpectrum, spectrum_match
+
+    acc = _spectrum_record()
+    grid = np.geomspace(0.05, 5.0, 60)
+    sa_rec = im.spectral_acceleration(acc, DT, grid)
+    e = 0.3 * np.sin(3 * np.log(grid))
+    target = TargetSpectrum(grid, 2.5 * sa_rec * np.exp(e))
+    m = spectrum_match(acc, DT, target, (0.2, 2.0), n_periods=25)
+    periods = np.geomspace(0.2, 2.0, 25)
+    np.testing.assert_allclose(m.periods, periods)
+    resid = np.log(target.at(periods) / im.spectral_acceleration(acc, DT, periods))
+    assert m.factor == pytest.approx(np.exp(resid.mean()), rel=1e-12)
+    assert m.misfit == pytest.approx(resid.std(), rel=1e-10)
+    best = optimize.minimize_scalar(lambda lf: np.sum((resid - lf) ** 2),
+                                    bracket=(0.0, 2.0), tol=1e-12)
+    assert np.log(m.factor) == pytest.approx(best.x, abs=1e-7)
+    # a target of the record's own spectral shape: its factor, misfit 0
+    own = TargetSpectrum(periods, 2.5 * im.spectral_acceleration(acc, DT, periods))
+    same = spectrum_match(acc, DT, own, (0.2, 2.0), n_periods=25)
+    assert same.factor == pytest.approx(2.5, rel=1e-12)
+    assert same.misfit < 1e-12
+
+
+def test_spectrum_match_anchored_at_t1_matches_there_exactly():
+    from shipblock.scaling import TargetSpectrum, spectrum_match
+
+    acc = _spectrum_record()
+    target = TargetSpectrum([0.05, 0.5, 5.0], [8.0, 10.0, 1.0])
+    m = spectrum_match(acc, DT, target, (0.2, 2.0), mode="anchor", anchor_period=1.0)
+    assert m.factor * im.spectral_acceleration(acc, DT, 1.0) == pytest.approx(
+        target.at(1.0)[0], rel=1e-12)
+    ranged = spectrum_match(acc, DT, target, (0.2, 2.0))
+    assert ranged.misfit <= m.misfit  # least squares is the smallest RMS over the range
+    with pytest.raises(ValueError, match="anchor_period"):
+        spectrum_match(acc, DT, target, (0.2, 2.0), mode="anchor")
+    with pytest.raises(ValueError, match="0 < T_a < T_b"):
+        spectrum_match(acc, DT, target, (2.0, 0.2))

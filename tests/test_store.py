@@ -28,6 +28,34 @@ def test_every_summary_field_has_units_and_long_name():
     assert RUN_VARIABLES["time_in_mode_3"][0] == "s"
 
 
+def test_time_in_mode_variables_say_what_the_mode_is():
+    """Mode k's long name has the paper's wording and its three interface states
+    (shipblock.modes: mode 3 rocks on stuck interfaces, mode 5 slides at both)."""
+    assert RUN_VARIABLES["time_in_mode_3"][1] == (
+        "time spent in mode 3: blocks rock (blocks on ground stick, blocks rocking, ship on "
+        "blocks stick)")
+    assert RUN_VARIABLES["time_in_mode_5"][1] == (
+        "time spent in mode 5: blocks and ship slide (blocks on ground slide, blocks at rest, "
+        "ship on blocks slide)")
+
+
+@pytest.mark.parametrize(("umask", "mode"), [(0o022, 0o644), (0o027, 0o640), (0o077, 0o600)])
+def test_result_files_get_the_permissions_of_a_new_file(tmp_path, umask, mode):
+    """Not tempfile's 0600: 0666 less the umask, as any new file."""
+    import os
+    import stat
+
+    ds = xr.Dataset({"a": ("x", np.arange(3.0), {"units": "m", "long_name": "a"})},
+                    coords={"x": ("x", np.arange(3), {"units": "1", "long_name": "x"})})
+    old = os.umask(umask)
+    try:
+        path = write_dataset(ds, tmp_path / "r.nc")
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(path.stat().st_mode) == mode
+    assert [p.name for p in tmp_path.iterdir()] == ["r.nc"]  # no temporary file left
+
+
 def test_chunk_store_round_trip_and_fingerprint(tmp_path):
     store = ChunkStore(tmp_path / "p", "abc").open({"n_cases": 10})
     assert store.completed() == set()

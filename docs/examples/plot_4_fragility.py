@@ -28,7 +28,7 @@ from shipblock.units import STANDARD_GRAVITY as G0
 motions = [process_motion(entry.read()) for entry in load_catalogue().values()]
 records = [(m.horizontal, m.vertical) for m in motions]
 dts = [m.dt for m in motions]
-pga_records = np.array([pga(m.horizontal, m.dt).value for m in motions])  # [m/s^2]
+pga_records = np.array([pga(m.horizontal, m.dt) for m in motions])  # [m/s^2]
 
 # %%
 # Cases are rows ``(record index, system index, horizontal factor, vertical factor)``.

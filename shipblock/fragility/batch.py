@@ -306,6 +306,7 @@ def run_batch(
     progress: bool = True,
     solver_options: Mapping | None = None,
     timings: dict | None = None,
+    runs=None,
 ) -> dict:
     """Run every case of a design, resuming from the chunks already in ``store``.
 
@@ -328,6 +329,9 @@ def run_batch(
     timings : dict, optional
         ``timings["solver"]`` is increased by the wall time spent in :func:`run_chunk` [s]
         (local runs only).
+    runs : array_like of bool, shape (n_records, n_levels), optional
+        The (record, level) pairs to run (e.g. without those scaled beyond a limit); the others
+        get NaN like a record's failure. Default: :meth:`AnalysisDesign.stripe_mask`.
 
     Returns
     -------
@@ -377,7 +381,7 @@ def run_batch(
     bar = tqdm(total=n, initial=done_cases, unit="run", desc="shipblock", disable=not progress,
                smoothing=0.1)
     try:
-        in_stripe = design.stripe_mask()
+        in_stripe = design.stripe_mask() if runs is None else np.asarray(runs, dtype=bool)
         tasks = {k: _Task(design, chunks[k], ok, in_stripe) for k in pending}
 
         def finish(k: int, out):

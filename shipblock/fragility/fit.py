@@ -17,9 +17,13 @@ Three kinds of analysis are supported, following Baker (2015) [1]_:
   is run and :math:`z_j` of them exceed the limit state. :func:`fit_mle` maximises the binomial
   likelihood; :func:`fit_msa` does the same from a record x IM-level exceedance matrix.
 * **Incremental dynamic analysis (IDA)**: each record is scaled up until it exceeds the limit
-  state, giving one IM capacity per record. :func:`fit_ida` uses the method of moments on
-  :math:`\ln` capacity or a right-censored maximum-likelihood estimate; :func:`ida_capacities`
-  turns an exceedance matrix into capacities.
+  state, giving one IM capacity per record. On discrete IM levels a record's capacity is only
+  known to lie between the last level that held and the first that failed:
+  :func:`fit_ida_levels` fits the exceedance matrix by interval-censored maximum likelihood
+  (:func:`fit_ida_intervals`, the default) or, as an option, takes the first exceeding level as
+  the capacity (biased high by up to one level step). :func:`ida_capacities` turns an exceedance
+  matrix into capacity bounds; :func:`fit_ida` fits capacities known exactly (e.g. from a
+  hunt-and-fill IDA), by the method of moments or right-censored maximum likelihood.
 * **Cloud analysis** of unscaled records: :func:`fit_cloud` regresses :math:`\ln \mathrm{EDP}`
   on :math:`\ln \mathrm{IM}` (Cornell et al. 2002 [2]_, Jalayer 2003 [3]_) or fits a probit
   to the binary outcome.
@@ -60,7 +64,10 @@ __all__ = [
     "IDACapacities",
     "bootstrap",
     "fit_cloud",
+    "IDA_METHODS",
     "fit_ida",
+    "fit_ida_intervals",
+    "fit_ida_levels",
     "fit_mle",
     "fit_msa",
     "ida_capacities",
@@ -118,7 +125,8 @@ class FragilityFit:
         Logarithmic standard deviation :math:`\beta` [-].
     method : str
         How the curve was fitted: ``"mle"``, ``"mle_fixed_beta"``, ``"ida_moments"``,
-        ``"ida_mle"``, ``"cloud_regression"`` or ``"cloud_probit"``.
+        ``"ida_mle"``, ``"ida_interval"``, ``"ida_first_exceedance"``,
+        ``"ida_first_exceedance_moments"``, ``"cloud_regression"`` or ``"cloud_probit"``.
     log_likelihood : float
         Maximised log-likelihood [-] (see the fitting function for its definition); ``nan``
         for moment estimators.
@@ -524,28 +532,36 @@ def fit_msa(exceeded, im_levels, valid=None, *, fixed_beta=None) -> FragilityFit
 
 
 class IDACapacities(NamedTuple):
-    """Per-record IM capacities extracted from an IDA exceedance matrix.
+    """Per-record IM capacity bounds extracted from an IDA exceedance matrix.
+
+    The capacity :math:`C_i` of record ``i`` lies in ``(held[i], capacity[i]]``.
 
     Attributes
     ----------
     capacity : numpy.ndarray, shape (n_records,)
-        IM at the first exceedance [IM units]; ``inf`` if the record never exceeded.
+        IM at the first exceedance [IM units], the upper bound of the capacity; ``inf`` if the
+        record never exceeded.
     censored_at : numpy.ndarray, shape (n_records,)
         Highest valid IM analysed for the record [IM units]: the right-censoring level of
         records that never exceeded (``nan`` if the record has no valid run at all; drop such
-        records before :func:`fit_ida`).
+        records before fitting).
     resurrected : numpy.ndarray of bool, shape (n_records,)
         Records that stopped exceeding at some valid level above their first exceedance
         (non-monotone IDA, "resurrection").
+    held : numpy.ndarray, shape (n_records,)
+        The last valid level below the first exceedance at which the record held [IM units],
+        the lower bound of the capacity: 0 if the record exceeded at its first valid level
+        (left-censored), ``censored_at`` if it never exceeded (right-censored).
     """
 
     capacity: np.ndarray
     censored_at: np.ndarray
     resurrected: np.ndarray
+    held: np.ndarray
 
 
 def ida_capacities(exceeded, im_levels, valid=None) -> IDACapacities:
-    """Per-record IM capacities from an IDA exceedance matrix (first-exceedance rule).
+    """Per-record IM capacity bounds from an IDA exceedance matrix.
 
     Parameters
     ----------
@@ -559,19 +575,20 @@ def ida_capacities(exceeded, im_levels, valid=None) -> IDACapacities:
     Returns
     -------
     IDACapacities
-        ``capacity``, ``censored_at`` and ``resurrected`` per record.
+        ``capacity`` (first exceeding level), ``held`` (last level that held below it),
+        ``censored_at`` and ``resurrected`` per record.
 
     Notes
     -----
-    The capacity of a record is the *first* IM level at which it exceeds the limit state.
+    The record is taken to fail at the *first* IM level at which it exceeds the limit state.
     Non-monotone IDA curves, where a record exceeds at one level and not at a higher one
     ("resurrection", Vamvatsikos & Cornell 2002 [1]_), are treated conservatively: the record is
     considered failed from its first exceedance on, and later non-exceedances are ignored. They
     are flagged in ``resurrected`` so that they can be reported.
 
-    With discrete IM levels the true capacity lies between the last non-exceeding level and
-    the first exceeding one; taking the latter biases the median upward by up to one level
-    step. Use closely spaced levels (or a hunt-and-fill IDA) when this matters.
+    With discrete IM levels the true capacity lies between the last level that held and the
+    first exceeding one, ``(held, capacity]``: taking the upper bound as the capacity biases
+    the median upward by up to one level step; :func:`fit_ida_intervals` uses the interval.
 
     References
     ----------
@@ -599,7 +616,15 @@ def ida_capacities(exceeded, im_levels, valid=None) -> IDACapacities:
     censored_at = np.where(any_valid, x[last_valid], np.nan)
     after_first = np.arange(x.size)[None, :] > first[:, None]
     resurrected = ever & np.any(after_first & w & ~e, axis=1)
-    return IDACapacities(capacity=capacity, censored_at=censored_at, resurrected=resurrected)
+    # last valid level that held below the first exceedance (all valid levels if none)
+    below = np.where(ever[:, None], np.arange(x.size)[None, :] < first[:, None], True)
+    held_mask = below & w & ~e
+    any_held = held_mask.any(axis=1)
+    last_held = held_mask.shape[1] - 1 - np.argmax(held_mask[:, ::-1], axis=1)
+    held = np.where(any_held, x[last_held], 0.0)
+    held = np.where(any_valid, held, np.nan)
+    return IDACapacities(capacity=capacity, censored_at=censored_at, resurrected=resurrected,
+                         held=held)
 
 
 def fit_ida(capacities, censored_at=None, *, method="mle") -> FragilityFit:
@@ -760,6 +785,221 @@ def _fit_ida_moments(c, n_censored):
         n=int(c.size),
         details={"n_censored": n_censored},
     )
+
+
+#: Methods of :func:`fit_ida_levels` (and of the pipeline's ``fit.ida_method``).
+IDA_METHODS = ("interval", "first_exceedance", "first_exceedance_moments")
+
+#: Largest dispersion accepted from the interval-censored fit [-]: beyond it the data do not
+#: bound beta (e.g. only left- and right-censored records) and the fit runs off to infinity.
+_MAX_BETA = 50.0
+
+
+def _log_interval_probability(a, b):
+    """``ln(Phi(b) - Phi(a))`` for ``a < b`` (either may be infinite), without cancellation.
+
+    Both bounds on the same side of zero are taken on that side's tail, where the difference of
+    two small probabilities keeps its relative precision.
+    """
+    log_pb, log_pa = special.log_ndtr(b), special.log_ndtr(a)
+    log_qa, log_qb = special.log_ndtr(-a), special.log_ndtr(-b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lower_tail = log_pb + np.log1p(-np.exp(log_pa - log_pb))  # both below zero
+        upper_tail = log_qa + np.log1p(-np.exp(log_qb - log_qa))  # both above zero
+        middle = np.log(special.ndtr(b) - special.ndtr(a))
+    return np.where(b <= 0.0, lower_tail, np.where(a >= 0.0, upper_tail, middle))
+
+
+def fit_ida_intervals(lower, upper) -> FragilityFit:
+    r"""Lognormal fragility from interval-censored IDA capacities.
+
+    Record ``i``'s capacity :math:`C_i` is known only to lie in ``(lower[i], upper[i]]``: on
+    discrete IM levels, between the last level at which the record held and the first at which
+    it exceeded the limit state. ``lower = 0`` is a record that exceeded at its first level
+    (left-censored), ``upper = inf`` one that never exceeded (right-censored). The
+    log-likelihood, maximised over :math:`(\ln\theta, \ln\beta)` with its analytic gradient,
+    is
+
+    .. math::
+
+        \ln L = \sum_i \ln\left[\Phi\!\left(\frac{\ln u_i - \ln\theta}{\beta}\right)
+               - \Phi\!\left(\frac{\ln l_i - \ln\theta}{\beta}\right)\right],
+
+    with :math:`\Phi(-\infty) = 0` and :math:`\Phi(\infty) = 1` (Lawless 2003 [1]_, sect.
+    2.2.1; the record-wise form of the IDA likelihood with the capacity between two stripes).
+    Unlike the first exceeding level, which is always above the capacity, this is unbiased on
+    coarse levels (tests/test_fragility_fit.py: mean of the medians within 2 % of the truth on
+    the demo's eight levels, where the first-exceedance estimate is 10-20 % high).
+
+    Parameters
+    ----------
+    lower : array_like, shape (n,)
+        Lower bounds [IM units], >= 0 (0: left-censored).
+    upper : array_like, shape (n,)
+        Upper bounds [IM units], > ``lower`` (``inf``: right-censored).
+
+    Returns
+    -------
+    FragilityFit
+        ``method="ida_interval"``, ``n`` the number of records, ``log_likelihood`` the value
+        above (probabilities, so it does not depend on the IM unit); ``details`` holds
+        ``n_left_censored``, ``n_right_censored`` and ``n_iterations``.
+
+    Raises
+    ------
+    FragilityFitError
+        If the data do not identify a finite (median, beta): no record exceeded (median only
+        bounded below), every record exceeded at its first level (only bounded above), every
+        interval shares a point (:math:`\beta \to 0`: add levels in between), or the fit runs
+        off to :math:`\beta >` 50 (the censored records alone do not bound it).
+    ValueError
+        On malformed input (shapes, NaN, ``lower < 0``, ``upper <= lower``).
+
+    References
+    ----------
+    .. [1] Lawless, J. F. (2003). *Statistical Models and Methods for Lifetime Data*, 2nd ed.
+       Wiley, sect. 2.2 (censoring) and 5.3 (interval censoring).
+    """
+    lo = np.asarray(lower, dtype=float)
+    hi = np.asarray(upper, dtype=float)
+    if lo.ndim != 1 or hi.shape != lo.shape:
+        raise ParameterError(
+            f"lower and upper must be 1-D of equal length, got shapes {lo.shape} and {hi.shape}"
+        )
+    if np.any(np.isnan(lo)) or np.any(np.isnan(hi)):
+        raise ParameterError("capacity bounds contain NaN: drop records without a valid run")
+    if np.any(lo < 0) or not np.all(np.isfinite(lo)):
+        raise ParameterError("lower bounds must be finite and >= 0 [IM units]")
+    if np.any(hi <= lo):
+        raise ParameterError("every upper bound must exceed its lower bound [IM units]")
+    left = lo == 0.0
+    right = ~np.isfinite(hi)
+    if np.all(right):
+        raise FragilityFitError(
+            "no record exceeded the limit state: the median is only bounded below by the "
+            f"highest level ({lo.max():g}); analyse higher IM levels"
+        )
+    if np.all(left):
+        raise FragilityFitError(
+            "every record exceeded at its first level: the median is only bounded above by "
+            f"the lowest level ({hi.min():g}); analyse lower IM levels"
+        )
+    if lo.max() <= hi.min():
+        raise FragilityFitError(
+            f"every record's capacity interval contains IM {hi.min():g} (all held at "
+            f"{lo.max():g} or below and exceeded at {hi.min():g} or above): beta -> 0 and the "
+            "median is not identified; add IM levels in between"
+        )
+    with np.errstate(divide="ignore"):
+        u_lo = np.log(lo)  # -inf for left-censored records
+    u_hi = np.log(hi)  # inf for right-censored records
+    # start: moments of the interval mid-points (one level step beyond a censoring level)
+    step = float(np.median(u_hi[~right & ~left] - u_lo[~right & ~left])) if np.any(
+        ~right & ~left) else 0.5
+    with np.errstate(invalid="ignore"):
+        mid = np.where(left, u_hi - 0.5 * step,
+                       np.where(right, u_lo + 0.5 * step, 0.5 * (u_lo + u_hi)))
+    x0 = np.array([float(np.mean(mid)), np.log(max(float(np.std(mid)), 0.5 * step, 0.05))])
+
+    def fun(p):
+        mu, log_s = p
+        s = np.exp(log_s)
+        a = (u_lo - mu) / s
+        b = (u_hi - mu) / s
+        log_p = _log_interval_probability(a, b)
+        # phi(bound)/P and bound*phi(bound)/P, 0 at an infinite bound
+        with np.errstate(invalid="ignore"):
+            ra = np.where(left, 0.0, np.exp(_norm_logpdf(a) - log_p))
+            rb = np.where(right, 0.0, np.exp(_norm_logpdf(b) - log_p))
+            ta = np.where(left, 0.0, a * ra)
+            tb = np.where(right, 0.0, b * rb)
+        nll = -float(np.sum(log_p))
+        g_mu = float(np.sum(rb - ra)) / s
+        g_ls = float(np.sum(tb - ta))
+        return nll, np.array([g_mu, g_ls])
+
+    res = optimize.minimize(fun, x0=x0, jac=True, method="BFGS",
+                            options={"gtol": _GTOL_PER_OBS * lo.size})
+    mu, sigma = float(res.x[0]), float(np.exp(res.x[1]))
+    if not np.isfinite(res.fun):
+        raise FragilityFitError("the interval-censored likelihood could not be evaluated")
+    if sigma > _MAX_BETA:
+        raise FragilityFitError(
+            f"fitted beta = {sigma:g}: the records' capacity bounds do not bound the dispersion "
+            "(too few records with a capacity between two analysed levels)"
+        )
+    if sigma < _MIN_BETA:
+        raise FragilityFitError(f"fitted beta = {sigma:g} ~ 0: dispersion not identified")
+    if not res.success and np.linalg.norm(res.jac) > 1e3 * _GTOL_PER_OBS * lo.size:
+        warnings.warn(
+            f"interval-censored IDA fit did not converge: {res.message}", RuntimeWarning,
+            stacklevel=2,
+        )
+    return FragilityFit(
+        median=float(np.exp(mu)),
+        beta=sigma,
+        method="ida_interval",
+        log_likelihood=float(-res.fun),
+        n=int(lo.size),
+        details={"n_left_censored": int(left.sum()), "n_right_censored": int(right.sum()),
+                 "n_iterations": int(res.nit)},
+    )
+
+
+def fit_ida_levels(exceeded, im_levels, valid=None, *, method="interval") -> FragilityFit:
+    """IDA fragility from a record x IM-level exceedance matrix.
+
+    Parameters
+    ----------
+    exceeded : array_like of bool, shape (n_records, m)
+        Whether record ``i`` scaled to IM level ``j`` exceeded the limit state.
+    im_levels : array_like, shape (m,)
+        IM levels [IM units], positive and strictly increasing.
+    valid : array_like of bool, shape (n_records, m), optional
+        Usable runs (default all). Records without any valid run are left out.
+    method : {"interval", "first_exceedance", "first_exceedance_moments"}
+        ``"interval"`` (default): each record's capacity lies between the last level that held
+        and the first that failed (:func:`ida_capacities`), fitted by
+        :func:`fit_ida_intervals`: unbiased on discrete levels.
+        ``"first_exceedance"``: the first exceeding level taken as the capacity, fitted by
+        right-censored maximum likelihood (:func:`fit_ida`, ``method="mle"``);
+        ``"first_exceedance_moments"``: the same capacities by the method of moments
+        (``method="moments"``). Both overestimate the median by up to one level step (about
+        half a step on average); they are kept to reproduce earlier studies.
+
+    Returns
+    -------
+    FragilityFit
+        ``method`` ``"ida_interval"``, ``"ida_first_exceedance"`` or
+        ``"ida_first_exceedance_moments"``.
+
+    Raises
+    ------
+    FragilityFitError
+        If the curve is not identified (see the fitting functions).
+    ValueError
+        On malformed input or an unknown method.
+
+    Notes
+    -----
+    The record axis comes first so that :func:`bootstrap` can resample records (rows).
+    """
+    if method not in IDA_METHODS:
+        raise ParameterError(f"method must be one of {', '.join(IDA_METHODS)}, got {method!r}")
+    e = np.asarray(exceeded, dtype=bool)
+    w = np.ones_like(e) if valid is None else np.asarray(valid, dtype=bool)
+    if e.ndim != 2 or w.shape != e.shape:
+        raise ParameterError(
+            f"exceeded and valid must be 2-D (n_records, n_levels) of one shape, got {e.shape} "
+            f"and {w.shape}"
+        )
+    keep = w.any(axis=1)
+    caps = ida_capacities(e[keep], im_levels, w[keep])
+    if method == "interval":
+        return fit_ida_intervals(caps.held, caps.capacity)
+    fit = fit_ida(caps.capacity, caps.censored_at,
+                  method="mle" if method == "first_exceedance" else "moments")
+    return replace(fit, method=f"ida_{method}")
 
 
 # ---------------------------------------------------------------------------------------------

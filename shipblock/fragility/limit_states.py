@@ -1,8 +1,11 @@
 r"""Limit states: named thresholds on the engineering demand parameters (EDPs) of a run.
 
 A limit state (LS) turns the per-run summary of a simulation into a yes/no outcome, for example
-"the ship slipped more than 5 cm on the blocks". Counting these outcomes over records and IM
-levels gives the data that :mod:`shipblock.fragility.fit` turns into fragility curves.
+"the ship slipped more than 5 cm on the blocks" or "a keel block carried more than its
+capacity" (``edp = "peak_ground_normal_force"``, or ``"peak_corner_load"`` for the load on a
+rocking block's edge: the contact loads of :mod:`shipblock.loads`, per block [N]). Counting
+these outcomes over records and IM levels gives the data that :mod:`shipblock.fragility.fit`
+turns into fragility curves.
 
 Limit states are declared in the pipeline TOML file::
 
@@ -41,6 +44,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from shipblock.errors import ParameterError
+from shipblock.loads import LOAD_FIELDS
 
 __all__ = [
     "CONDITIONS",
@@ -97,6 +101,9 @@ EDP_VARIABLES: Mapping[str, EDPInfo] = MappingProxyType(
         "residual_block_slip": EDPInfo("m", "residual block slip", "float", True, True),
         "residual_ship_slip": EDPInfo("m", "residual ship slip", "float", True, True),
         "uplift": EDPInfo("1", "block uplift (rocking) occurred", "bool", True),
+        # contact loads, per block (shipblock.loads): e.g. "keel block load above its capacity"
+        **{name: EDPInfo(units, long_name, "float", True)
+           for name, (units, long_name) in LOAD_FIELDS.items()},
         "n_impacts": EDPInfo("1", "number of rocking impacts", "count", True),
         "failure": EDPInfo(
             "1", "failure code (0 none, 1 separation, 2 overturning)", "code", False

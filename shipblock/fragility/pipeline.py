@@ -20,6 +20,7 @@ Schema (``schema_version = 1``; units in brackets, paths relative to the pipelin
     azimuth = 0.0                       # dock transverse axis [deg from north], or
     horizontal = "H1"                   # one horizontal as recorded (default "H1")
     response = "sensitivity"            # or "full" (instrument response removal)
+    strict = false                      # true: fail if a record is left out or a run refused
 
     [[processing]]                      # optional; absent: shipblock.processing.DEFAULT_CHAIN
     step = "demean"                     # processing = [] for no processing
@@ -40,6 +41,15 @@ Schema (``schema_version = 1``; units in brackets, paths relative to the pipelin
                                         # "unscaled" or "zero"
     stripes = [["NP.1737", "NP.1743"], ["NP.1759", "NP.1765"], ...]
                                         # msa only, optional: the records of each level
+    max_scale_factor = 5.0              # warn about runs scaled by more (default 5) [-]
+    scale_factor_policy = "warn"        # or "refuse": runs scaled by more are not made
+
+    [design.target_spectrum]            # optional, ida/msa on measure "sa" (T1 = period)
+    file = "target.csv"                 # two columns: period [s], Sa [units]
+    units = "g"                         # unit of the Sa column (required)
+    period_range = [0.2, 2.0]           # [T_a, T_b] [s]
+    match = "range"                     # least squares in ln Sa over the range (default), or
+                                        # "anchor": Sa(T1) matched, misfit over the range
     cloud_method = "probit"             # cloud only: "probit" or "regression"
 
     [[limit_states]]                    # see shipblock.fragility.limit_states
@@ -51,7 +61,9 @@ Schema (``schema_version = 1``; units in brackets, paths relative to the pipelin
     bootstrap = 200                     # resamples over records (0: no bounds)
     confidence = 0.9
     seed = 1
-    ida_method = "mle"                  # or "moments"
+    ida_method = "interval"             # capacity between the last level held and the first
+                                        # failed (default); or "first_exceedance" (the first
+                                        # failed level, biased high), "first_exceedance_moments"
 
     [solver]
     rtol = 1e-8
@@ -84,7 +96,9 @@ ranges of the module constants (:data:`MAX_BOOTSTRAP`, :data:`MAX_SEED`, :data:`
 IM levels are converted to SI once, here: ``levels_g`` multiplies by
 :data:`shipblock.units.STANDARD_GRAVITY`; ``levels`` with ``units`` goes through
 :func:`shipblock.units.acceleration_to_si` (:func:`shipblock.units.velocity_to_si` for PGV).
-The dataset stores the levels, medians and achieved IMs in SI.
+The dataset stores the levels, medians and achieved IMs in SI; with ``levels_g`` the levels and
+medians also in g (``im_level_g``, ``median_g``, ...), and the fits, their messages and the
+command's output use the pipeline's unit.
 """
 
 from __future__ import annotations
@@ -123,10 +137,11 @@ from shipblock.fragility.design import (
     IntensityDesign,
 )
 from shipblock.fragility.fit import (
+    IDA_METHODS,
     FragilityFitError,
     bootstrap,
     fit_cloud,
-    fit_ida,
+    fit_ida_levels,
     fit_msa,
     ida_capacities,
 )
@@ -181,6 +196,10 @@ SCHEMA_VERSION = 1
 
 #: Default largest number of time-history files of a pipeline's [histories] request.
 DEFAULT_MAX_HISTORIES = 100
+
+#: Default largest scale factor of a run made without a warning [-]: a common practical
+#: ceiling of amplitude scaling (studies commonly keep factors below about 4 to 5).
+DEFAULT_MAX_SCALE_FACTOR = 5.0
 
 #: Defaults of the [fit] table.
 DEFAULT_BOOTSTRAP = 200
@@ -255,6 +274,7 @@ _SCHEMA: dict[str, dict[str, tuple]] = {
         "azimuth": (_NUM, False),
         "horizontal": ((str,), False),
         "response": ((str,), False),
+        "strict": ((bool,), False),
     },
     "system": {
         **{name: (_NUM, False) for name in SYSTEM_FIELDS if name != "impact_rule"},
@@ -275,6 +295,15 @@ _SCHEMA: dict[str, dict[str, tuple]] = {
         "vertical_levels_g": ((list,), False),
         "cloud_method": ((str,), False),
         "stripes": ((list,), False),
+        "max_scale_factor": (_NUM, False),
+        "scale_factor_policy": ((str,), False),
+        "target_spectrum": ((dict,), False),
+    },
+    "design.target_spectrum": {
+        "file": ((str,), True),
+        "units": ((str,), True),
+        "period_range": ((list,), True),
+        "match": ((str,), False),
     },
     "fit": {
         "bootstrap": ((int,), False),
@@ -489,6 +518,20 @@ class Pipeline:
         Output file (absolute).
     histories : HistoryRequest or None
         Runs whose full time histories are written; None for none.
+    max_scale_factor : float
+        Largest scale factor [-] a run is made with silently (``design.max_scale_factor``).
+    scale_factor_policy : str
+        ``"warn"`` (run and report) or ``"refuse"`` (do not make) a run scaled by more.
+    strict : bool
+        Fail, rather than go on without them, when records are left out or runs refused
+        (``records.strict``).
+    im_display : tuple of (str, float)
+        The unit the pipeline gives its IM levels in (``"g"`` for ``levels_g``, else
+        ``design.units``) and its value in SI units: the unit of the messages, of the
+        command's output and of the result's ``*_g`` companions.
+    target_spectrum : dict or None
+        ``[design.target_spectrum]``: ``spectrum`` (:class:`~shipblock.scaling.TargetSpectrum`),
+        ``file``, ``units``, ``period_range`` [s], ``match``; None without one.
     """
 
     source: str
@@ -507,6 +550,11 @@ class Pipeline:
     scheduler: str | None
     output: Path
     histories: HistoryRequest | None = None
+    max_scale_factor: float = DEFAULT_MAX_SCALE_FACTOR
+    scale_factor_policy: str = "warn"
+    strict: bool = False
+    im_display: tuple[str, float] = ("m/s^2", 1.0)
+    target_spectrum: dict | None = None
 
     def identity(self) -> dict:
         """The parts of the document that determine the results (no output path, scheduler
@@ -519,8 +567,8 @@ class Pipeline:
         doc = {k: v for k, v in self.document.items()
                if k not in ("output", "title", "description", "histories")}
         doc["execution"] = {"chunk_size": self.chunk_size}
-        doc["records"] = {**doc["records"], "catalogue": str(self.catalogue),
-                          "ids": list(self.design.records)}
+        doc["records"] = {**{k: v for k, v in doc["records"].items() if k != "strict"},
+                          "catalogue": str(self.catalogue), "ids": list(self.design.records)}
         return doc
 
 
@@ -776,14 +824,22 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
         "bootstrap": _integer(f, "bootstrap", DEFAULT_BOOTSTRAP, 0, MAX_BOOTSTRAP, "fit", source),
         "confidence": float(f.get("confidence", DEFAULT_CONFIDENCE)),
         "seed": _integer(f, "seed", DEFAULT_SEED, 0, MAX_SEED, "fit", source),
-        "ida_method": f.get("ida_method", "mle"),
+        "ida_method": f.get("ida_method", "interval"),
         "cloud_method": cloud_method,
     }
     if not 0 < fit["confidence"] < 1:
         raise PipelineError("fit.confidence", f"must lie in (0, 1), got {fit['confidence']}",
                             source)
-    if fit["ida_method"] not in ("mle", "moments"):
-        raise PipelineError("fit.ida_method", "must be 'mle' or 'moments'", source)
+    if fit["ida_method"] in ("mle", "moments"):
+        old = "first_exceedance" + ("_moments" if fit["ida_method"] == "moments" else "")
+        raise PipelineError("fit.ida_method", f"{fit['ida_method']!r} took the first exceeding "
+                            f"level as the capacity; that estimate is now named {old!r} (it "
+                            "overestimates the median by up to one level step); the default "
+                            "'interval' fits the capacity between the last level that held and "
+                            "the first that failed", source)
+    if fit["ida_method"] not in IDA_METHODS:
+        raise PipelineError("fit.ida_method", f"must be one of {', '.join(map(repr, IDA_METHODS))}"
+                            f", got {fit['ida_method']!r}", source)
     s = doc.get("solver", {})
     solver = {"rtol": float(s.get("rtol", DEFAULT_RTOL)),
               "atol": float(s.get("atol", DEFAULT_ATOL)),
@@ -807,8 +863,133 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
         horizontal=horizontal, response=response, chain=chain, design=design,
         limit_states=limit_states, fit=fit, solver=solver, chunk_size=int(chunk_size),
         scheduler=scheduler, output=_output_path(doc["output"], base, source),
-        histories=histories,
+        histories=histories, **_scaling_limits(doc, source),
+        im_display=_im_display(d, measure, source),
+        target_spectrum=_target_spectrum(d, intensity, base, source),
     )
+
+
+def _target_spectrum(design: Mapping, intensity: IntensityDesign, base: Path, source: str):
+    """The ``[design.target_spectrum]`` table, read and checked (see ``Pipeline``)."""
+    from shipblock.scaling import MATCH_MODES, TargetSpectrumError, read_target_spectrum
+
+    if "target_spectrum" not in design:
+        return None
+    table = design["target_spectrum"]
+    _check_table(table, "design.target_spectrum", source)
+    key = "design.target_spectrum"
+    if intensity.kind not in ("ida", "msa") or intensity.measure != "sa":
+        raise PipelineError(key, "scaling to a target spectrum needs type 'ida' or 'msa' on "
+                            "measure = 'sa' (its period is T1, where the target is anchored to "
+                            "the levels)", source)
+    rng = _numbers(table["period_range"], f"{key}.period_range", source)
+    if len(rng) != 2 or not 0 < rng[0] < rng[1]:
+        raise PipelineError(f"{key}.period_range", f"must be [T_a, T_b] with 0 < T_a < T_b [s],"
+                            f" got {table['period_range']!r}", source)
+    match = table.get("match", "range")
+    if match not in MATCH_MODES:
+        raise PipelineError(f"{key}.match", f"must be one of {', '.join(map(repr, MATCH_MODES))}"
+                            f", got {match!r}", source)
+    try:
+        spectrum = read_target_spectrum(base / table["file"], table["units"])
+        spectrum.at([rng[0], rng[1], intensity.period])
+    except TargetSpectrumError as exc:
+        raise PipelineError(f"{key}.file", str(exc), source) from None
+    return {"spectrum": spectrum, "file": str(base / table["file"]), "units": table["units"],
+            "period_range": rng, "match": match}
+
+
+def _match_target_spectrum(pipe: Pipeline, record) -> dict | None:
+    """Scale a prepared record to the target spectrum at every level (in place).
+
+    The batch scaled it to Sa(T1) = level (``match = "anchor"``: kept). With ``"range"`` the
+    factor at level ``j`` becomes ``level_j / Sa_target(T1) * f``, ``f`` the least-squares
+    factor of the record to the target over the range (the target anchored at each level is
+    the file's spectrum times ``level_j / Sa_target(T1)``): every factor and achieved IM is
+    multiplied by ``f Sa_record(T1) / Sa_target(T1)``, as is the vertical's in mode "same".
+
+    Returns
+    -------
+    dict or None
+        ``misfit`` [-], ``sa_record`` on the matching periods [m/s^2]; None for a record left
+        out.
+    """
+    from shipblock.scaling import spectrum_match
+
+    target = pipe.target_spectrum
+    if target is None or record.error is not None:
+        return None
+    intensity = pipe.design.intensity
+    try:
+        m = spectrum_match(record.horizontal, record.dt, target["spectrum"],
+                           target["period_range"], mode=target["match"],
+                           anchor_period=intensity.period, damping=intensity.damping)
+    except ShipblockError as exc:
+        record.error = f"{type(exc).__name__}: {exc}"
+        return None
+    if target["match"] == "range":
+        ratio = m.factor * record.im / float(target["spectrum"].at(intensity.period)[0])
+        record.factor_h = record.factor_h * ratio
+        record.achieved = record.achieved * ratio
+        if intensity.vertical == "same":
+            record.factor_v = record.factor_v * ratio
+            record.achieved_v = record.achieved_v * ratio
+    return {"misfit": m.misfit, "periods": m.periods, "sa_record": m.sa_record,
+            "sa_target": m.sa_target}
+
+
+def _spectrum_variables(pipe: Pipeline, matches) -> tuple[dict, dict]:
+    """Variables and attributes of the target-spectrum match (none without a target)."""
+    target = pipe.target_spectrum
+    if target is None:
+        return {}, {}
+    ok = [m for m in matches if m is not None]
+    periods = ok[0]["periods"] if ok else np.geomspace(*target["period_range"], 40)
+    n = periods.size
+    misfit = np.array([np.nan if m is None else m["misfit"] for m in matches])
+    sa = np.array([np.full(n, np.nan) if m is None else m["sa_record"] for m in matches])
+    lo, hi = target["period_range"]
+    coords = {"spectrum_period": ("spectrum_period", periods,
+                                  {"units": "s", "long_name": "period of the spectrum match"})}
+    data = {
+        "spectrum_misfit": (("record",), misfit, {
+            "units": "1", "long_name": f"RMS of ln(Sa scaled / Sa target) from {lo:g} to "
+            f"{hi:g} s (match {target['match']!r})"}),
+        "record_sa": (("record", "spectrum_period"), sa, {
+            "units": "m/s^2", "long_name": "pseudo-spectral acceleration of the processed, "
+                                           "unscaled record"}),
+        "target_sa": (("spectrum_period",), target["spectrum"].at(periods), {
+            "units": "m/s^2", "long_name": "target spectrum as given (at each level it is "
+            "scaled to Sa(T1) = level)"}),
+    }
+    attrs = {"target_spectrum_file": target["file"], "target_spectrum_units": target["units"],
+             "target_spectrum_period_range": list(target["period_range"]),
+             "target_spectrum_match": target["match"]}
+    return {"coords": coords, "data": data}, attrs
+
+
+def _im_display(design: Mapping, measure: str, source: str) -> tuple[str, float]:
+    """The unit the pipeline writes its IM in and its SI value (see ``Pipeline.im_display``)."""
+    if "levels_g" in design or ("units" not in design and measure != "pgv"):
+        return "g", STANDARD_GRAVITY
+    if "units" in design:
+        return design["units"], _im_factor(measure, design["units"], "design.units", source)
+    return "m/s", 1.0
+
+
+def _scaling_limits(doc, source) -> dict:
+    """``max_scale_factor``, ``scale_factor_policy`` ([design]) and ``strict`` ([records])."""
+    d = doc["design"]
+    limit = d.get("max_scale_factor", DEFAULT_MAX_SCALE_FACTOR)
+    if not (math.isfinite(limit) and limit >= 1.0):
+        raise PipelineError("design.max_scale_factor", f"must be a number >= 1, got {limit!r}",
+                            source)
+    policy = d.get("scale_factor_policy", "warn")
+    if policy not in ("warn", "refuse"):
+        raise PipelineError("design.scale_factor_policy",
+                            f"must be 'warn' or 'refuse', got {policy!r}", source)
+    return {"max_scale_factor": float(limit), "scale_factor_policy": policy,
+            "strict": bool(doc["records"].get("strict", False))}
 
 
 def _output_path(value: str, base: Path, source: str, key: str = "output") -> Path:
@@ -887,11 +1068,12 @@ def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng):
     capacity = None
     n_boot = fit_opts["bootstrap"]
     try:
+        if not keep.any():
+            raise FragilityFitError("no record has a valid run: nothing to fit")
         if kind == "ida":
-            caps = ida_capacities(e[keep], levels, w[keep])
-            capacity = caps
-            args = {"capacities": caps.capacity, "censored_at": caps.censored_at}
-            fn, kw = fit_ida, {"method": fit_opts["ida_method"]}
+            capacity = ida_capacities(e[keep], levels, w[keep])
+            args = {"exceeded": e[keep], "valid": w[keep]}
+            fn, kw = fit_ida_levels, {"im_levels": levels, "method": fit_opts["ida_method"]}
         elif kind == "msa":
             args = {"exceeded": e[keep], "valid": w[keep]}
             fn, kw = fit_msa, {"im_levels": levels}
@@ -941,18 +1123,21 @@ class _FitCheckpoint:
     def __init__(self, store: ChunkStore, n_records: int):
         self.store = store
         self.n_records = n_records
-        self.pending: dict[int, tuple[dict, np.ndarray]] = {}
+        self.pending: dict[int, tuple[dict, np.ndarray, np.ndarray]] = {}
         self.last = time.monotonic()
         self.next_id = max(store.completed("fit"), default=-1) + 1
 
-    def load(self) -> dict[int, tuple[dict, np.ndarray]]:
-        """Fits done by an earlier, interrupted run: ``{f: (results, capacity column)}``."""
+    def load(self) -> dict[int, tuple[dict, np.ndarray, np.ndarray]]:
+        """Fits done by an earlier, interrupted run.
+
+        ``{f: (results, capacity column, capacity_held column)}``, the columns over the records.
+        """
         done = {}
         for k in sorted(self.store.completed("fit")):
             try:
                 fits, arrays = self.store.read(k, "fit")
-                capacity = np.asarray(arrays["capacity"], dtype=float).reshape(
-                    len(fits), self.n_records)
+                capacity, held = (np.asarray(arrays[n], dtype=float).reshape(
+                    len(fits), self.n_records) for n in ("capacity", "capacity_held"))
                 rows = [dict(zip(_FIT_FLOATS + _FIT_INTS + _FIT_STRINGS, values, strict=True))
                         for values in zip(*(arrays[n].tolist() for n in
                                              _FIT_FLOATS + _FIT_INTS + _FIT_STRINGS),
@@ -961,23 +1146,24 @@ class _FitCheckpoint:
                 logger.warning("fitted results %d unusable (%s); fitting again", k, exc)
                 self.store.discard(k, "fit")
                 continue
-            for f, row, col in zip(fits.tolist(), rows, capacity, strict=True):
-                done[f] = (row, col)
+            for f, row, col, col_held in zip(fits.tolist(), rows, capacity, held, strict=True):
+                done[f] = (row, col, col_held)
         return done
 
-    def add(self, f: int, result: dict, capacity: np.ndarray) -> None:
-        self.pending[f] = (result, capacity)
+    def add(self, f: int, result: dict, capacity: np.ndarray, held: np.ndarray) -> None:
+        self.pending[f] = (result, capacity, held)
         if time.monotonic() - self.last >= FIT_CHECKPOINT_INTERVAL:
             self.flush()
 
     def flush(self) -> None:
         if self.pending:
             fits = np.array(list(self.pending), dtype=np.int64)
-            rows = [r for r, _ in self.pending.values()]
+            rows = [r for r, _, _ in self.pending.values()]
             arrays = {n: np.array([r[n] for r in rows], dtype=float) for n in _FIT_FLOATS}
             arrays.update({n: np.array([r[n] for r in rows], dtype=np.int64) for n in _FIT_INTS})
             arrays.update({n: np.array([r[n] for r in rows], dtype=str) for n in _FIT_STRINGS})
-            arrays["capacity"] = np.stack([c for _, c in self.pending.values()])
+            arrays["capacity"] = np.stack([c for _, c, _ in self.pending.values()])
+            arrays["capacity_held"] = np.stack([h for _, _, h in self.pending.values()])
             self.store.write(self.next_id, fits, arrays, group="fit")
             self.next_id += 1
             self.pending = {}
@@ -985,7 +1171,8 @@ class _FitCheckpoint:
 
 
 def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fit_opts,
-                        store: ChunkStore | None = None) -> dict:
+                        store: ChunkStore | None = None,
+                        im_display: tuple[str, float] = ("", 1.0)) -> dict:
     """Exceedance, fitted median/beta and bootstrap bounds of every limit state.
 
     Parameters
@@ -1004,6 +1191,11 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
         are done (at most every :data:`FIT_CHECKPOINT_INTERVAL` seconds), and those it holds
         from an interrupted run are used instead of fitted again. Each fit is a function of
         its own data and seed only, so the results are the same bit for bit.
+    im_display : tuple of (str, float)
+        Unit the pipeline writes its IM in and its SI value (:attr:`Pipeline.im_display`): the
+        fits are made in it, so that their messages (``fit_error``) quote the levels as the
+        pipeline wrote them, and with ``"g"`` the medians are stored in g too (``median_g``,
+        ``median_lower_g``, ``median_upper_g``). Default: SI.
 
     Returns
     -------
@@ -1011,13 +1203,16 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
         Name -> :class:`xarray.DataArray` with ``units`` and ``long_name``: ``exceeded`` and
         ``valid`` on ``(limit_state, *design.dims)``; ``median``, ``beta``, their bounds,
         ``fit_method``, ``fit_error``, ``n_fit_records``, ``bootstrap_failed`` on
-        ``(limit_state, *sweep)``; ``ida_capacity`` on ``(limit_state, record, *sweep)`` for
+        ``(limit_state, *sweep)``; ``ida_capacity`` and ``ida_capacity_lower`` (the first
+        level that failed and the last that held) on ``(limit_state, record, *sweep)`` for
         IDA. Bootstrap resampling of combination ``c`` of limit state ``i`` is seeded with
         ``[seed, i, c]``.
     """
     intensity = design.intensity
     kind = intensity.kind
-    levels = np.asarray(intensity.levels, dtype=float)
+    unit, factor = im_display
+    unit = unit or intensity.units
+    levels = np.asarray(intensity.levels, dtype=float) / factor  # in the pipeline's unit
     ex = evaluate_limit_states(limit_states, ds)
     names = [ls.name for ls in limit_states]
     sweep_dims = design.sweep_names
@@ -1031,7 +1226,8 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
     fields["fit_error"] = np.full((n_ls, *sweep_shape), "", dtype=object)
     n_records = len(design.records)
     capacity = np.full((n_ls, n_records, *sweep_shape), np.nan)
-    im = ds["achieved_im"].values if not intensity.scaled else None
+    capacity_held = capacity.copy()
+    im = ds["achieved_im"].values / factor if not intensity.scaled else None
     checkpoint = None if store is None else _FitCheckpoint(store, n_records)
     done = {} if checkpoint is None else checkpoint.load()
     if done:
@@ -1045,20 +1241,28 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
         for c, combo in enumerate(itertools.product(*(range(n) for n in sweep_shape))):
             f = i * design.n_systems + c
             if f in done:
-                res, col = done[f]
+                res, col, col_held = done[f]
             else:
                 sel = (slice(None),) * lead + combo
                 rng = np.random.default_rng([int(fit_opts["seed"]), i, c])
                 res, caps = _fit_one(kind, e_all[sel], w_all[sel], levels, im, edp_all[sel],
                                      ls, fit_opts, rng)
+                for k in ("median", "median_lower", "median_upper"):
+                    res[k] *= factor  # back to SI
+                if res["fit_error"]:
+                    res["fit_error"] += f" [IM in {unit}]"
                 col = np.full(n_records, np.nan)
+                col_held = np.full(n_records, np.nan)
                 if caps is not None:
-                    col[w_all[sel].any(axis=1)] = caps.capacity
+                    keep = w_all[sel].any(axis=1)
+                    col[keep] = caps.capacity * factor
+                    col_held[keep] = caps.held * factor
                 if checkpoint is not None:
-                    checkpoint.add(f, res, col)
+                    checkpoint.add(f, res, col, col_held)
             for k, v in res.items():
                 fields[k][(i, *combo)] = v
             capacity[(i, slice(None), *combo)] = col
+            capacity_held[(i, slice(None), *combo)] = col_held
     if checkpoint is not None:
         checkpoint.flush()
     im_units = intensity.units
@@ -1083,6 +1287,10 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
             attrs["confidence"] = fit_opts["confidence"]
             attrs["n_bootstrap"] = int(fit_opts["bootstrap"])
         out[k] = xr.DataArray(fields[k], dims=dims_fit, attrs=attrs)
+    if unit == "g" and factor == STANDARD_GRAVITY:
+        for k in ("median", "median_lower", "median_upper"):
+            out[f"{k}_g"] = xr.DataArray(fields[k] / factor, dims=dims_fit, attrs={
+                **out[k].attrs, "units": "g", "long_name": out[k].attrs["long_name"] + " in g"})
     dims_run = ("limit_state", *design.dims)
     out["exceeded"] = xr.DataArray(
         np.stack([ex[n].exceeded.transpose(*design.dims).values for n in names]), dims=dims_run,
@@ -1094,8 +1302,13 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
     if kind == "ida":
         out["ida_capacity"] = xr.DataArray(
             capacity, dims=("limit_state", "record", *sweep_dims),
-            attrs={"units": im_units, "long_name": "IDA capacity: first IM level exceeding the "
-                   "limit state (inf: never; NaN: no valid run)"})
+            attrs={"units": im_units, "long_name": "IDA capacity, upper bound: first IM level "
+                   "exceeding the limit state (inf: never; NaN: no valid run)"})
+        out["ida_capacity_lower"] = xr.DataArray(
+            capacity_held, dims=("limit_state", "record", *sweep_dims),
+            attrs={"units": im_units, "long_name": "IDA capacity, lower bound: last IM level "
+                   "that held below the first exceedance (0: exceeded at the first level; NaN: "
+                   "no valid run)"})
     return out
 
 
@@ -1176,6 +1389,115 @@ def _dask_client_class(scheduler: str, source: str):
     return Client
 
 
+def _scale_factors(pipe: Pipeline, records) -> np.ndarray:
+    """|Scale factor| of every (record, level) [-]: the horizontal's, and the vertical's when it
+    is scaled to its own targets; NaN for a record left out."""
+    f = np.array([np.abs(r.factor_h) for r in records], dtype=float)
+    if pipe.design.intensity.vertical == "independent":
+        fv = np.array([np.abs(r.factor_v) for r in records], dtype=float)
+        f = np.fmax(f, fv)
+    return f
+
+
+def _record_use(pipe: Pipeline, records):
+    """Runs scaled beyond the limit, those refused, and the records left out (with reasons).
+
+    Returns ``(above, refused, left_out)``: two (record, level) masks and ``{id: reason}``.
+    Warns about runs above the limit; raises :class:`PipelineError` under ``records.strict``
+    if a record is left out or a run refused.
+    """
+    design = pipe.design
+    factors = _scale_factors(pipe, records)
+    with np.errstate(invalid="ignore"):
+        above = (factors > pipe.max_scale_factor) & design.stripe_mask()
+    if not design.intensity.scaled:
+        above[:] = False
+    refused = above if pipe.scale_factor_policy == "refuse" else np.zeros_like(above)
+    left_out = {}
+    for i, r in enumerate(records):
+        if r.error is not None:
+            left_out[r.id] = r.error
+        elif not (design.stripe_mask()[i] & ~refused[i]).any():
+            f = factors[i][design.stripe_mask()[i]]
+            left_out[r.id] = (f"every run refused: scale factors {f.min():.4g} to {f.max():.4g} "
+                              f"above max_scale_factor {pipe.max_scale_factor:g}")
+    if above.any():
+        worst = np.unravel_index(np.nanargmax(np.where(above, factors, np.nan)), above.shape)
+        what = "not run" if pipe.scale_factor_policy == "refuse" else "run"
+        unit, per_unit = pipe.im_display
+        logger.warning(
+            "%d of %d runs have a scale factor above max_scale_factor = %g (%s; the largest, %.4g, "
+            "is %s at %s %.4g %s)", int(above.sum()), int(design.stripe_mask().sum()),
+            pipe.max_scale_factor, what, factors[worst], design.records[worst[0]],
+            design.intensity.measure.upper(), design.intensity.levels[worst[1]] / per_unit, unit)
+    if pipe.strict and (left_out or refused.any()):
+        why = [f"{rid} ({reason})" for rid, reason in left_out.items()]
+        if refused.any():
+            why.append(f"{int(refused.sum())} runs refused for their scale factor")
+        raise PipelineError("records.strict", "the study would go on without some of its "
+                            f"records or runs: {'; '.join(why)}", pipe.source)
+    for rid, reason in left_out.items():
+        if records[design.records.index(rid)].error is None:  # errors were said when read
+            logger.warning("record %s left out: %s", rid, reason)
+    return above, refused, left_out
+
+
+def records_used_message(n_records: int, left_out: Mapping[str, str]) -> str:
+    """``"7 of 9 records used, 2 left out: A (why); B (why)"``.
+
+    Parameters
+    ----------
+    n_records : int
+        Records named by the study.
+    left_out : mapping
+        Record id -> reason, for the records left out.
+
+    Returns
+    -------
+    str
+    """
+    used = n_records - len(left_out)
+    text = f"{used} of {n_records} records used"
+    if left_out:
+        text += f", {len(left_out)} left out: " + "; ".join(
+            f"{rid} ({reason})" for rid, reason in left_out.items())
+    return text
+
+
+def _add_record_use(ds, pipe: Pipeline, records, above, refused, left_out) -> xr.Dataset:
+    """Scale-factor limit, refused runs and records used, as variables and attributes."""
+    design = pipe.design
+    limit = pipe.max_scale_factor
+    if design.intensity.scaled:
+        ds["scale_factor_above_limit"] = xr.DataArray(
+            above, dims=("record", "im_level"),
+            attrs={"units": "1", "long_name": f"scale factor above max_scale_factor = {limit:g} "
+                   f"(policy {pipe.scale_factor_policy!r}: "
+                   f"{'not run' if pipe.scale_factor_policy == 'refuse' else 'run, reported'})",
+                   "max_scale_factor": limit})
+        if refused.any():
+            factors = _scale_factors(pipe, records)
+            errors = ds["run_error"].transpose(*design.dims).values.copy()
+            for r, j in zip(*np.nonzero(refused), strict=True):
+                errors[r, j, ...] = (f"not run: scale factor {factors[r, j]:.4g} above "
+                                     f"max_scale_factor {limit:g}")
+            ds["run_error"] = ds["run_error"].copy(data=errors)
+    ds["record_used"] = xr.DataArray(
+        np.array([r not in left_out for r in design.records]), dims=("record",),
+        attrs={"units": "1", "long_name": "record used in the study (see record_error or "
+                                          "the attribute records_used for why not)"})
+    for rid, reason in left_out.items():
+        if not ds["record_error"].sel(record=rid).item():
+            ds["record_error"].loc[{"record": rid}] = reason
+    ds.attrs.update({
+        "max_scale_factor": limit,
+        "scale_factor_policy": pipe.scale_factor_policy,
+        "n_records_used": len(design.records) - len(left_out),
+        "records_used": records_used_message(len(design.records), left_out),
+    })
+    return ds
+
+
 def _loader(entry, pipe: Pipeline):
     def load():
         kwargs = {"response": pipe.response}
@@ -1252,8 +1574,10 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         prepare_record(rid, _loader(entries[rid], pipe), pipe.chain, design.intensity)
         for rid in design.records
     ]
-    if all(r.error is not None for r in records):
-        reasons = "; ".join(f"{r.id}: {r.error}" for r in records)
+    matches = [_match_target_spectrum(pipe, r) for r in records]
+    above, refused, left_out = _record_use(pipe, records)
+    if len(left_out) == len(records):
+        reasons = "; ".join(f"{rid}: {why}" for rid, why in left_out.items())
         raise PipelineError("records.ids", f"every record was left out, so there is nothing to "
                                            f"run: {reasons}", pipe.source)
     fingerprint = _fingerprint(pipe, records)
@@ -1273,7 +1597,8 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
             raise PipelineError("output", str(exc), pipe.source) from None
         clock.lap("records")
         results = run_batch(design, records, store, chunk_size=pipe.chunk_size, client=client,
-                            progress=progress, solver_options=pipe.solver, timings=timings)
+                            progress=progress, solver_options=pipe.solver, timings=timings,
+                            runs=design.stripe_mask() & ~refused)
     finally:
         if own_client is not None:
             own_client.close()
@@ -1281,7 +1606,11 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     ds = summary_dataset(design, records, results)
     ds = ds.assign_coords({k: xr.Variable(*v) for k, v in _limit_state_coords(
         pipe.limit_states).items()})
-    ds = ds.assign(fragility_variables(ds, design, pipe.limit_states, pipe.fit, store))
+    ds = ds.assign(fragility_variables(ds, design, pipe.limit_states, pipe.fit, store,
+                                       im_display=pipe.im_display))
+    if pipe.im_display[0] == "g" and design.intensity.scaled:
+        ds = ds.assign_coords(im_level_g=("im_level", ds["im_level"].values / STANDARD_GRAVITY, {
+            "units": "g", "long_name": ds["im_level"].attrs["long_name"] + " in g"}))
     chain = [dict(e) for e in (DEFAULT_CHAIN if pipe.chain is None else pipe.chain)]
     intensity = design.intensity
     ds.attrs = {
@@ -1296,6 +1625,8 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         "im_units": intensity.units,
         "im_long_name": intensity.long_name,
         "im_damping": intensity.damping,
+        "im_display_units": pipe.im_display[0],
+        "im_display_factor": pipe.im_display[1],
         "vertical_mode": intensity.vertical,
         "component": (f"azimuth {pipe.azimuth:g} deg" if pipe.azimuth is not None
                       else str(pipe.horizontal)),
@@ -1310,6 +1641,12 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     }
     if intensity.period is not None:
         ds.attrs["im_period"] = intensity.period
+    ds = _add_record_use(ds, pipe, records, above, refused, left_out)
+    spectrum, spectrum_attrs = _spectrum_variables(pipe, matches)
+    if spectrum:
+        ds = ds.assign_coords({k: xr.Variable(*v) for k, v in spectrum["coords"].items()})
+        ds = ds.assign({k: xr.Variable(*v) for k, v in spectrum["data"].items()})
+        ds.attrs.update(spectrum_attrs)
     clock.lap("fragility")
     if pipe.histories is not None:
         ds = _add_histories(ds, pipe, records, out_path, fingerprint, progress)
@@ -1335,7 +1672,8 @@ def _add_histories(ds, pipe: Pipeline, records, out_path: Path, fingerprint: str
     directory = request.directory or out_path.with_name(out_path.stem + "_histories")
     cases = request.select(ds, design)
     attrs = {"pipeline": pipe.text, "pipeline_source": str(pipe.source),
-             "solver_options": json.dumps(pipe.solver, sort_keys=True)}
+             "solver_options": json.dumps(pipe.solver, sort_keys=True),
+             "im_display_units": pipe.im_display[0], "im_display_factor": pipe.im_display[1]}
     written = write_histories(design, records, cases, directory, pipe.solver, fingerprint,
                               attrs, progress)
     files = np.full(design.n_cases, "", dtype=object)
@@ -1408,8 +1746,11 @@ def _rerun(path, record, im_level=None, im_level_g=None, **sweep):
     records = [None] * len(design.records)
     records[r] = prepare_record(rid, _loader(load_catalogue(pipe.catalogue)[rid], pipe),
                                 pipe.chain, design.intensity)
+    _match_target_spectrum(pipe, records[r])
     result = run_case(design, records, case, pipe.solver)
     ds = case_dataset(result, design, records, case,
                       {"pipeline": pipe.text, "pipeline_source": str(pipe.source),
-                       "solver_options": json.dumps(pipe.solver, sort_keys=True)})
+                       "solver_options": json.dumps(pipe.solver, sort_keys=True),
+                       "im_display_units": pipe.im_display[0],
+                       "im_display_factor": pipe.im_display[1]})
     return ds, result

@@ -29,8 +29,8 @@ import glob
 import json
 import os
 import re
+import secrets
 import shutil
-import tempfile
 import zipfile
 from pathlib import Path
 
@@ -39,6 +39,7 @@ import xarray as xr
 
 from shipblock.errors import ShipblockError
 from shipblock.fragility.limit_states import EDP_VARIABLES
+from shipblock.modes import MODE_DESCRIPTIONS, MODE_FLAGS
 from shipblock.solver import MODE_TIME_FIELDS, SUMMARY_FIELDS
 
 __all__ = [
@@ -58,7 +59,8 @@ COMPRESSION_LEVEL = 4
 _MANIFEST = "manifest.json"
 #: File groups of a partial-results directory: batch chunks and fitted results.
 _GROUPS = ("chunk", "fit")
-#: The random part :func:`tempfile.mkstemp` puts in a name.
+#: The random part of a temporary file's name: 8 hex characters (:func:`_temporary`), or the 8
+#: characters ``tempfile.mkstemp`` used in earlier builds, so that their leftovers go too.
 _RANDOM = r"[A-Za-z0-9_]{8}"
 
 
@@ -86,7 +88,12 @@ def _run_variables() -> dict[str, tuple[str, str]]:
         elif name in extra:
             out[name] = extra[name]
         elif name.startswith("time_in_mode_"):
-            out[name] = ("s", f"time spent in mode {name.rsplit('_', 1)[1]}")
+            mode = int(name.rsplit("_", 1)[1])
+            flags = ", ".join(f"{what} {state[bit]}" for what, state, bit in zip(
+                ("blocks on ground", "blocks", "ship on blocks"),
+                (("stick", "slide"), ("at rest", "rocking"), ("stick", "slide")),
+                MODE_FLAGS[mode], strict=True))
+            out[name] = ("s", f"time spent in mode {mode}: {MODE_DESCRIPTIONS[mode]} ({flags})")
         else:  # a summary field added to the solver later
             out[name] = ("1", name.replace("_", " "))
     return out
@@ -105,8 +112,19 @@ RUN_VARIABLES: dict[str, tuple[str, str]] = _run_variables()
 
 
 def _temporary(path: Path) -> tuple[int, str]:
-    """A new temporary file for ``path``, in its folder: ``.<name>.<random>.tmp``."""
-    return tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    """A new temporary file for ``path``, in its folder: ``.<name>.<8 random hex>.tmp``.
+
+    Opened exclusively with mode 0666, which the umask reduces as for any new file (0644 under
+    the usual 022): ``tempfile.mkstemp`` creates its files 0600 whatever the umask, and the
+    rename would keep that, leaving result files unreadable to the rest of a team.
+    """
+    for _ in range(100):
+        tmp = path.parent / f".{path.name}.{secrets.token_hex(4)}.tmp"
+        try:
+            return os.open(tmp, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o666), str(tmp)
+        except FileExistsError:
+            continue
+    raise StoreError(f"cannot create a temporary file next to {path}")
 
 
 def _is_temporary_of(name: str, target: str) -> bool:
@@ -363,7 +381,8 @@ def write_dataset(ds: xr.Dataset, path) -> Path:
 
     The file is written with the ``netcdf4`` engine and zlib compression of every numeric
     variable to a temporary file next to ``path``, then renamed over ``path``: a reader (or a
-    crash) never sees a half-written file.
+    crash) never sees a half-written file. It gets the permissions of any new file (0666 less
+    the umask: 0644 under the usual umask 022).
 
     Parameters
     ----------

@@ -52,8 +52,19 @@ SUMMARY_FIELDS = {
     "impact_loss": K.S_IMPACT_LOSS,
     "n_mode_fallbacks": K.S_N_FALLBACK,
     "final_energy": K.S_ENERGY_FINAL,
+    "peak_ground_normal_force": K.S_PEAK_FY,
+    "peak_ground_friction_force": K.S_PEAK_FX,
+    "peak_ship_normal_force": K.S_PEAK_SFY,
+    "peak_ship_friction_force": K.S_PEAK_SFX,
+    "peak_ground_friction_utilisation": K.S_PEAK_UTIL_G,
+    "peak_ship_friction_utilisation": K.S_PEAK_UTIL_S,
+    "peak_corner_load": K.S_PEAK_CORNER,
 }
 MODE_TIME_FIELDS = [f"time_in_mode_{m}" for m in range(1, 9)]
+#: Summary fields the kernel keeps as totals over the n blocks [N] and the wrappers report per
+#: block (divided by ``n_blocks``).
+PER_BLOCK_FIELDS = ("peak_ground_normal_force", "peak_ground_friction_force",
+                    "peak_ship_normal_force", "peak_ship_friction_force", "peak_corner_load")
 
 
 def _is_motion(value) -> bool:
@@ -243,6 +254,8 @@ def _summary_dict(summary: np.ndarray, system: ShipBlockSystem) -> dict:
     for m, name in enumerate(MODE_TIME_FIELDS):
         out[name] = values[K.S_MODE_TIME + m]
     out["peak_rotation_ratio"] = out["peak_rotation"] / system.critical_angle
+    for name in PER_BLOCK_FIELDS:
+        out[name] /= system.n_blocks
     out["uplift"] = bool(out["uplift"])
     out["n_impacts"] = int(out["n_impacts"])
     out["failure"] = int(out["failure"])
@@ -405,7 +418,11 @@ def simulate_batch(
         out[name] = by_field[K.S_MODE_TIME + m]
     thc = params[par_idx, P_THC]
     out["peak_rotation_ratio"] = out["peak_rotation"] / thc
+    n_blocks = np.array([s.n_blocks for s in systems], dtype=float)[par_idx]
+    for name in PER_BLOCK_FIELDS:
+        out[name] = out[name] / n_blocks
     return out
 
 
-__all__ = ["simulate", "simulate_batch", "RecordSet", "SUMMARY_FIELDS", "MODE_TIME_FIELDS"]
+__all__ = ["simulate", "simulate_batch", "RecordSet", "SUMMARY_FIELDS", "MODE_TIME_FIELDS",
+           "PER_BLOCK_FIELDS"]

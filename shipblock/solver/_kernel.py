@@ -96,8 +96,15 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     S_N_EVENTS,
     S_N_FALLBACK,
     S_N_IMPACTS,
+    S_PEAK_CORNER,
+    S_PEAK_FX,
+    S_PEAK_FY,
+    S_PEAK_SFX,
+    S_PEAK_SFY,
     S_PEAK_TH,
     S_PEAK_TH_TIME,
+    S_PEAK_UTIL_G,
+    S_PEAK_UTIL_S,
     S_PEAK_XB,
     S_PEAK_XS,
     S_RES_XB,
@@ -116,6 +123,7 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     Y_XS,
     parameter_tuple,
 )
+from shipblock.solver._loads import note_loads, span_loads, state_loads
 from shipblock.solver._stuck_rocking import (
     advance_stuck,
     is_stuck_rocking,
@@ -678,6 +686,8 @@ summary, y_init
     if ms[MS_ROCK]:
         uplift = 1
     event_values(p, ms, y, 0, 0.0, dt, ax, ay, has_ay, sh, sv, g0, w7)
+    if failure == 0:
+        note_loads(p, ms[MS_ROCK], w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY], summary)
     if store:
         store_sample(p, ms, y, hist, modes, 0, 0 if failure else mode_number(ms))
     h_rock = dt
@@ -687,12 +697,15 @@ summary, y_init
         if ms[MS_ROCK] == 0:
             # rest and sliding: closed form, sample by sample, up to the next event
             k_before = k
+            tau_before = tau
             span_impact = False
             k, tau, best_e, span_time, peak_xb, peak_xs = nonrocking_span(
                 p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs, store,
                 hist, modes, span_work)
             if best_e != -2:
                 summary[S_MODE_TIME + mode_number(ms) - 1] += span_time
+                span_loads(p_vec, ms, span_work, ax, ay, has_ay, sh, sv, dt, k_before,
+                           tau_before, k, tau, summary)
             if k != k_before:
                 events_here = 0
             if best_e == -1:
@@ -709,7 +722,7 @@ summary, y_init
                 k_before = k
                 k, tau, span_impact, span_time, peak_th, peak_th_time = stuck_rocking_span(
                     p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol, armed, g0, g1,
-                    peak_th, peak_th_time, store, hist, modes, mode_number(ms))
+                    peak_th, peak_th_time, store, hist, modes, mode_number(ms), summary)
                 if span_time > 0.0:
                     summary[S_MODE_TIME + mode_number(ms) - 1] += span_time
                     fsal = False
@@ -817,7 +830,8 @@ summary, y_init
                             best_h = root
                             best_e = e
                 if best_e < 0:
-                    # accept the whole step
+                    # accept the whole step (w7b: the forces at its end)
+                    note_loads(p, 1, w7b[I_FX], w7b[I_FY], w7b[I_SFX], w7b[I_SFY], summary)
                     peak_th, peak_th_time = rotation_peak(
                         peak_th, peak_th_time, y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h,
                         k * dt + tau, k * dt + (tau + h))
@@ -845,6 +859,7 @@ summary, y_init
             fsal = False
             t_now = k * dt + tau
             from_mode = mode_number(ms)
+            state_loads(p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary)
             trigger = -1
             kind = EventKind.START
             if best_e == EV_G_SLIP:
@@ -900,6 +915,7 @@ summary, y_init
                             armed[e] = True
                     if ms[MS_ROCK]:
                         uplift = 1
+                    state_loads(p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary)
             if failure != 0:
                 failure_time = t_now
             if n_ev < log_size:

@@ -57,7 +57,16 @@ S_IMPACT_LOSS = 21
 S_N_FALLBACK = 22
 S_ENERGY_FINAL = 23  # T + V at the end
 S_PEAK_TH_TIME = 24
-N_SUMMARY = 25
+# Peak contact loads (see shipblock.solver._loads): interface forces, totals over the n blocks
+# [N], and friction utilisations [-].
+S_PEAK_FY = 25  # ground on blocks, normal
+S_PEAK_FX = 26  # ground on blocks, |friction|
+S_PEAK_SFY = 27  # blocks on ship, normal
+S_PEAK_SFX = 28  # blocks on ship, |friction|
+S_PEAK_UTIL_G = 29  # |fx| / (mu_s1 fy)
+S_PEAK_UTIL_S = 30  # |Fx| / (mu_s2 Fy)
+S_PEAK_CORNER = 31  # fy while the blocks rock (on their pivot corners)
+N_SUMMARY = 32
 
 # Work array of the closed-form spans (one per run, see ``nonrocking_span``): the event
 # functions, then per response slot its state (0 not solved, 1 solved, 2 singular) and its two

@@ -70,6 +70,7 @@ from shipblock.solver._layout import (
     Y_XB,
     Y_XS,
 )
+from shipblock.solver._loads import note_loads
 from shipblock.system import P_G, P_M, P_NM, P_R
 
 #: Largest |delta| [rad] for the series of :func:`small_angle_sincos` (truncation below 1e-17
@@ -514,7 +515,7 @@ def checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0
 
 @njit(cache=True, error_model="numpy", _nrt=False)
 def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol, armed, g0, g1,
-                       peak_th, peak_th_time, store, hist, modes, mode):
+                       peak_th, peak_th_time, store, hist, modes, mode, summary):
     """Advance mode 3 to the next sample and on by whole samples, up to the next event.
 
     The rocking counterpart of :func:`~shipblock.solver._closed_form.nonrocking_span`: the
@@ -548,6 +549,9 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
         Running peak of |theta| and its time.
     store, hist, modes, mode
         History output as in ``run``, and the mode number to write.
+    summary : ndarray, shape (N_SUMMARY,)
+        The run's summary: the contact loads at every accepted step's end raise its peaks
+        (:func:`~shipblock.solver._loads.note_loads`).
 
     Returns
     -------
@@ -600,6 +604,7 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
                                        b1, f0, fh, h, dt, rtol, atol, armed, g1, True, False)
             if verdict == STEP_ACCEPTED:
                 all_armed = rearm(armed, g1)
+                note_loads(p, 1, fx1, fy1, Fx1, Fy1, summary)
                 t0 = k * dt + tau
                 peak_th, peak_th_time = rotation_peak(peak_th, peak_th_time, th, om, al, th1,
                                                       om1, al1, h, t0,
@@ -629,6 +634,7 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
                               1.0, dt, dt, rtol, atol, armed, g1, not all_armed, True)
         if verdict != STEP_ACCEPTED:
             break
+        note_loads(p, 1, fx1, fy1, Fx1, Fy1, summary)
         if not all_armed:
             all_armed = rearm(armed, g1)
         if om * om1 <= 0.0:

@@ -1,0 +1,100 @@
+"""What a study prints and draws: the sweep table, plot --set, the median against a sweep,
+limit-state definitions, records per level and readable observed fractions."""
+
+from __future__ import annotations
+
+import matplotlib
+import numpy as np
+import pytest
+
+from shipblock.cli import main
+from shipblock.fragility.pipeline import run_pipeline
+from shipblock.fragility.report import fit_lines, study_report
+from shipblock.plot import DODGE, plot_fragility, plot_median_sweep, sweep_selection
+from shipblock.units import STANDARD_GRAVITY as G
+
+from .test_pipeline import write_pipeline
+
+matplotlib.use("Agg")
+
+LEVELS = "levels_g = [0.2, 0.3, 0.4, 0.45, 0.5]"
+
+
+@pytest.fixture(scope="module")
+def sweep_run(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("sweep")
+    path = write_pipeline(tmp, levels=LEVELS, sweep="[sweep]\nmu_ship = [0.3, 0.35]\n")
+    return tmp, path, run_pipeline(path, progress=False)
+
+
+def test_the_command_line_prints_a_table_of_medians_per_swept_value(sweep_run, capsys):
+    tmp, path, ds = sweep_run
+    assert main(["-q", "run", str(path), "-o", str(tmp / "again.nc")]) == 0
+    out = capsys.readouterr().out
+    assert "3 of 3 records used" in out
+    header = "fitted fragility (lognormal, ida_interval): median PGA [g] (90 % bootstrap band), " \
+             "beta"
+    assert header in out
+    table = out.split("  ship_slip:\n", 1)[1].splitlines()
+    assert table[0].split() == ["mu_ship", "median", "band", "beta"]
+    for row, mu in zip(table[1:3], (0.3, 0.35), strict=True):
+        cells = row.split()
+        assert float(cells[0]) == mu
+        median = float(ds["median"].sel(limit_state="ship_slip", mu_ship=mu))
+        if np.isfinite(median):
+            assert cells[1] == f"{median / G:.3g}"
+            assert cells[-1] == f"{float(ds['beta'].sel(limit_state='ship_slip', mu_ship=mu)):.3f}"
+        else:
+            assert "not fitted" in row
+    assert fit_lines(ds) == study_report(ds)[-len(fit_lines(ds)):]
+
+
+def test_sweep_selection_matches_values_and_names_the_choices(sweep_run):
+    _, _, ds = sweep_run
+    assert sweep_selection(ds) == {"mu_ship": 0.3}
+    assert sweep_selection(ds, {"mu_ship": 0.35 + 1e-12}) == {"mu_ship": 0.35}
+    with pytest.raises(ValueError, match="values: 0.3, 0.35"):
+        sweep_selection(ds, {"mu_ship": 0.4})
+    with pytest.raises(ValueError, match="swept: mu_ship"):
+        sweep_selection(ds, {"mu_ground": 0.4})
+
+
+def test_fragility_figure_names_thresholds_records_per_level_and_the_swept_value(sweep_run):
+    _, _, ds = sweep_run
+    ax = plot_fragility(ds, sweep={"mu_ship": 0.35})
+    title = ax.get_title()
+    assert "3 records per level" in title and "mu_ship = 0.35" in title
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels[0].startswith("ship_slip (peak_ship_slip > 0.005 m)")
+    assert labels[1].startswith("any_failure (failure != 0)")
+    median = float(ds["median"].sel(limit_state="ship_slip", mu_ship=0.35)) / G
+    if np.isfinite(median):
+        assert f"median {median:.3g} g" in labels[0]
+    # observed fractions of the two limit states side by side at every level, the offset
+    # DODGE of the axis, and the fractions the counts of the study
+    markers = [ln for ln in ax.get_lines() if ln.get_linestyle() == "None"]
+    assert len(markers) == 2
+    x0, x1 = (ln.get_xdata() for ln in markers)
+    np.testing.assert_allclose(x1 - x0, DODGE * ax.get_xlim()[1], rtol=1e-12)
+    np.testing.assert_allclose((x0 + x1) / 2, [0.2, 0.3, 0.4, 0.45, 0.5], rtol=1e-12)
+    ex = ds["exceeded"].sel(limit_state="ship_slip", mu_ship=0.35)
+    np.testing.assert_array_equal(markers[0].get_ydata(), ex.mean("record").values)
+
+
+def test_plot_command_draws_the_swept_value_asked_for_and_the_median_against_the_sweep(
+        sweep_run, tmp_path, capsys):
+    tmp, _, ds = sweep_run
+    nc = tmp / "out" / "result.nc"
+    png = tmp_path / "f.png"
+    assert main(["-q", "plot", str(nc), "--set", "mu_ship=0.35", "-o", str(png)]) == 0
+    assert png.exists()
+    assert main(["-q", "plot", str(nc), "--kind", "median", "-o", str(tmp_path / "m.png")]) == 0
+    assert (tmp_path / "m.png").exists()
+    assert main(["-q", "plot", str(nc), "--set", "mu_ship=0.4", "-o", str(png)]) == 2
+    assert "mu_ship = 0.4 is not a value of the study; values: 0.3, 0.35" in \
+        capsys.readouterr().err
+    ax = plot_median_sweep(ds)
+    assert ax.get_xlabel().startswith("mu_ship [-]")
+    line = ax.get_lines()[0]
+    np.testing.assert_allclose(line.get_ydata(),
+                               ds["median"].sel(limit_state="ship_slip").values / G)
