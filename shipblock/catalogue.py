@@ -120,11 +120,21 @@ def _path(base: Path, value, catalogue: Path, entry_id: str, key: str) -> Path:
     return path
 
 
+#: Keys of a catalogue record whose values are words (strings).
+_TEXT_KEYS = ("id", "network", "station", "site", "license", "credit")
+
+
 def _entry(table: dict, base: Path, catalogue: Path) -> CatalogueEntry:
     entry_id = table.get("id", "?")
     missing = [k for k in _REQUIRED if k not in table]
     if missing:
         raise RecordError(catalogue, f"record {entry_id!r} lacks {', '.join(missing)}")
+    for key in _TEXT_KEYS:
+        if key in table and not isinstance(table[key], str):
+            raise RecordError(catalogue, f"record {entry_id!r}: {key} must be a string, got"
+                                         f" {table[key]!r}")
+    if not table["id"].strip():
+        raise RecordError(catalogue, "a record's id is empty: id must be a non-empty string")
     files = table["files"]
     if isinstance(files, str):
         files = [files]
