@@ -94,7 +94,19 @@ class CatalogueEntry:
         -------
         GroundMotion
             The motion, with the catalogue entry's licence and credit in ``metadata["catalogue"]``.
+
+        Raises
+        ------
+        ParameterError
+            If a keyword is one the entry sets (``units``, ``inventory``, ``event``,
+            ``channel_map``, the files), or as :func:`shipblock.read_motion` for a wrong one.
         """
+        fixed = sorted(set(kwargs) & {"paths_or_stream", "inventory", "units", "channel_map",
+                                      "event"})
+        if fixed:
+            raise ParameterError(f"{fixed[0]} is set by the catalogue entry {self.id!r}; edit"
+                                 " the catalogue to change it (or read the files with"
+                                 " read_motion)")
         gm = read_motion(
             [str(p) for p in self.files],
             inventory=None if self.inventory is None else str(self.inventory),

@@ -487,6 +487,10 @@ READER_CASES = {
     "catalogue folder": (lambda: _catalogue(DATA), RecordError,
                          "is a folder, not a file .path must name a catalogue"),
     "catalogue number": (lambda: _catalogue(5), ParameterTypeError, "path must be a path"),
+    "catalogue entry units": (lambda: _entry().read(units="g"), ParameterError,
+                              "units is set by the catalogue entry 'south-napa-2014/NP.1737'"),
+    "catalogue entry azimuth": (lambda: _entry().read(azimuth="N"), ParameterTypeError,
+                                "azimuth must be a number"),
     "from_arrays 100 g": (lambda: _arrays(ACC * 1e3), ParameterError,
                           "horizontal has .* above the plausibility limit .*100 g"),
     "from_arrays 200 g in g": (lambda: _arrays(ACC * 200.0, units="g"), ParameterError,
@@ -537,6 +541,12 @@ def _catalogue(path):
     from shipblock.catalogue import load_catalogue
 
     return load_catalogue(path)
+
+
+def _entry():
+    from shipblock.catalogue import load_catalogue
+
+    return load_catalogue()["south-napa-2014/NP.1737"]
 
 
 def _arrays(horizontal, vertical=None, **kwargs):
