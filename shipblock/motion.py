@@ -321,7 +321,7 @@ def _load_stream(paths_or_stream, units, fmt, read_kwargs) -> Stream:
 def _load_inventory(inventory):
     if inventory is None or isinstance(inventory, obspy.Inventory):
         return inventory, ("<inventory>" if inventory is not None else None)
-    name = checks.existing_file(inventory, "inventory", "a StationXML file")
+    name = os.fspath(inventory)  # an existing file: check_read_arguments
     try:
         return obspy.read_inventory(name), name
     except Exception as exc:  # noqa: BLE001 - any parser failure means a bad inventory file
@@ -344,9 +344,7 @@ def _load_event(event):
             raise RecordError(name, "holds no event")
         event = catalog[0]
     elif isinstance(event, obspy.Catalog):
-        if len(event) == 0:
-            raise ParameterError("event must hold an earthquake, got an empty obspy Catalog")
-        event = event[0]
+        event = event[0]  # not empty: check_read_arguments
     origin = event.preferred_origin() or (event.origins[0] if event.origins else None)
     magnitude = event.preferred_magnitude() or (event.magnitudes[0] if event.magnitudes else None)
     summary = {"id": str(event.resource_id)}

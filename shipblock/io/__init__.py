@@ -29,7 +29,9 @@ K-NET and KiK-net files are read by obspy and renamed the SEED way by
 :class:`~shipblock.errors.RecordError` naming the file, so that a damaged file (a warning of
 libmseed, a MiniSEED record cut short, an implausible interval, start time or sample) is refused
 rather than read, and so that plain text files (which obspy cannot auto-detect, their units being
-unknown) are read with the caller's ``units``.
+unknown) are read with the caller's ``units``. Its arguments are checked before the file is
+opened (:mod:`shipblock.checks`, :func:`check_format`): a wrong one is a
+:class:`~shipblock.errors.ParameterError` that names it.
 """
 
 from __future__ import annotations
