@@ -13,7 +13,8 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from shipblock.errors import RecordError
+from shipblock import checks
+from shipblock.errors import ParameterError, ParameterTypeError, RecordError
 from shipblock.motion import COMPONENTS, GroundMotion, read_motion
 
 __all__ = ["CatalogueEntry", "catalogue_toml", "default_catalogue_path", "load_catalogue"]
@@ -93,7 +94,19 @@ class CatalogueEntry:
         -------
         GroundMotion
             The motion, with the catalogue entry's licence and credit in ``metadata["catalogue"]``.
+
+        Raises
+        ------
+        ParameterError
+            If a keyword is one the entry sets (``units``, ``inventory``, ``event``,
+            ``channel_map``, the files), or as :func:`shipblock.read_motion` for a wrong one.
         """
+        fixed = sorted(set(kwargs) & {"paths_or_stream", "inventory", "units", "channel_map",
+                                      "event"})
+        if fixed:
+            raise ParameterError(f"{fixed[0]} is set by the catalogue entry {self.id!r}; edit"
+                                 " the catalogue to change it (or read the files with"
+                                 " read_motion)")
         gm = read_motion(
             [str(p) for p in self.files],
             inventory=None if self.inventory is None else str(self.inventory),
@@ -119,21 +132,43 @@ def _path(base: Path, value, catalogue: Path, entry_id: str, key: str) -> Path:
     return path
 
 
+#: Keys of a catalogue record whose values are words (strings).
+_TEXT_KEYS = ("id", "network", "station", "site", "license", "credit")
+
+
 def _entry(table: dict, base: Path, catalogue: Path) -> CatalogueEntry:
     entry_id = table.get("id", "?")
     missing = [k for k in _REQUIRED if k not in table]
     if missing:
         raise RecordError(catalogue, f"record {entry_id!r} lacks {', '.join(missing)}")
+    for key in _TEXT_KEYS:
+        if key in table and not isinstance(table[key], str):
+            raise RecordError(catalogue, f"record {entry_id!r}: {key} must be a string, got"
+                                         f" {table[key]!r}")
+    if not table["id"].strip():
+        raise RecordError(catalogue, "a record's id is empty: id must be a non-empty string")
     files = table["files"]
     if isinstance(files, str):
         files = [files]
+    if not isinstance(files, list):
+        raise RecordError(catalogue, f"record {entry_id!r}: files must be a path or a list of"
+                                     f" paths, got {files!r}")
     if not files:
         raise RecordError(catalogue, f"record {entry_id!r} lists no files")
-    components = dict(table.get("components", {}))
+    components = table.get("components", {})
+    if not isinstance(components, dict):
+        raise RecordError(catalogue, f"record {entry_id!r}: components must be a table of channel"
+                                     f" code = component, got {components!r}")
     bad = {k: v for k, v in components.items() if v not in COMPONENTS}
     if bad:
         raise RecordError(catalogue, f"record {entry_id!r}: components must map to {COMPONENTS}:"
                                      f" {bad}")
+    units = table.get("units")
+    if units is not None:
+        try:
+            checks.unit(units, "units")
+        except ParameterError as exc:
+            raise RecordError(catalogue, f"record {entry_id!r}: {exc}") from None
     known = {"id", "files", "inventory", "event", "network", "station", "site", "license",
              "credit", "components", "units"}
     return CatalogueEntry(
@@ -148,8 +183,8 @@ def _entry(table: dict, base: Path, catalogue: Path) -> CatalogueEntry:
         site=str(table.get("site", "")),
         license=str(table.get("license", "")),
         credit=str(table.get("credit", "")),
-        components=components,
-        units=table.get("units"),
+        components=dict(components),
+        units=units,
         extra={k: v for k, v in table.items() if k not in known},
     )
 
@@ -169,24 +204,37 @@ def load_catalogue(path=None) -> dict[str, CatalogueEntry]:
 
     Raises
     ------
+    ParameterError
+        If ``path`` is not a path (also a :class:`TypeError`).
     RecordError
-        If the file is missing or malformed, an entry lacks a required key, an id repeats, or a
-        listed file does not exist.
+        If the file is missing, a folder or malformed, an entry lacks a required key or has one of
+        the wrong type (files, components, an unknown units word), an id repeats, or a listed
+        file does not exist.
     """
-    catalogue = Path(path) if path is not None else default_catalogue_path()
+    catalogue = (default_catalogue_path() if path is None
+                 else Path(checks.pathname(path, "path", "a catalogue TOML file")))
+    if catalogue.is_dir():
+        raise RecordError(catalogue, "is a folder, not a file (path must name a catalogue TOML"
+                                     " file; 'shipblock catalogue FOLDER' writes one)")
     try:
         with open(catalogue, "rb") as fh:
             document = tomllib.load(fh)
     except FileNotFoundError:
-        raise RecordError(catalogue, "catalogue file not found") from None
-    except tomllib.TOMLDecodeError as exc:
+        raise RecordError(catalogue, "catalogue file not found (path must name a catalogue TOML"
+                                     " file)") from None
+    except OSError as exc:
+        raise RecordError(catalogue, f"cannot be read: {exc}") from exc
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise RecordError(catalogue, f"is not valid TOML: {exc}") from exc
     version = document.get("schema_version", SCHEMA_VERSION)
     if version != SCHEMA_VERSION:
         raise RecordError(catalogue, f"schema_version {version} is not {SCHEMA_VERSION}")
     base = catalogue.resolve().parent
+    tables = document.get("record", [])
+    if not (isinstance(tables, list) and all(isinstance(t, dict) for t in tables)):
+        raise RecordError(catalogue, "record must be an array of tables ([[record]] sections)")
     entries: dict[str, CatalogueEntry] = {}
-    for table in document.get("record", []):
+    for table in tables:
         entry = _entry(table, base, catalogue)
         if entry.id in entries:
             raise RecordError(catalogue, f"record id {entry.id!r} appears twice")
@@ -274,11 +322,27 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
     -------
     str
         TOML text.
+
+    Raises
+    ------
+    ParameterError
+        Naming the argument (also a :class:`TypeError` for a wrong type): ``motions`` not a
+        MotionSet, ``output`` not a path, ``licence`` or ``credit`` not a string, an unknown
+        ``units``.
     """
     import numpy as np
 
+    from shipblock.collection import MotionSet
     from shipblock.units import STANDARD_GRAVITY
 
+    if not isinstance(motions, MotionSet):
+        raise ParameterTypeError(f"motions must be a MotionSet (from read_motions), got "
+                                 f"{type(motions).__name__} {motions!r}"[:300])
+    output = checks.pathname(output, "output", "the catalogue file to write")
+    licence = checks.text(licence, "licence", optional=True)
+    credit = checks.text(credit, "credit", optional=True)
+    if units is not None:
+        checks.unit(units, "units")
     base = Path(output).resolve().parent
     inventories = _station_inventories(p for p in motions.skipped if p.lower().endswith(".xml"))
     lines = [

@@ -12,20 +12,27 @@ recorded are about 4 g) or a sampling interval outside :data:`MIN_TIME_STEP` ..
 :data:`MAX_TIME_STEP` is a corrupt number or a unit mistake, not a record. The same limits are
 applied by the record readers (:mod:`shipblock.io`), so whatever a reader accepts the solver
 runs.
+
+Paths are checked the same way: a value that is not a ``str`` or :class:`os.PathLike` is a
+:class:`~shipblock.errors.ParameterTypeError` naming the argument (:func:`pathname`); a path that
+names no file, or a folder where a file is needed, is a :class:`~shipblock.errors.RecordError`
+that names the path and the argument (:func:`existing_file`).
 """
 
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Collection
 
 import numpy as np
 
-from shipblock.errors import ParameterError, ParameterTypeError
-from shipblock.units import STANDARD_GRAVITY
+from shipblock.errors import ParameterError, ParameterTypeError, RecordError
+from shipblock.units import ACCELERATION_UNITS_TO_SI, STANDARD_GRAVITY, VELOCITY_UNITS_TO_SI
 
 __all__ = [
     "MAX_ACCELERATION",
+    "MAX_AZIMUTH",
     "MAX_DURATION",
     "MAX_PADDING",
     "MAX_PERIOD",
@@ -33,10 +40,16 @@ __all__ = [
     "MIN_PERIOD",
     "MIN_TIME_STEP",
     "acceleration",
+    "azimuth",
     "choice",
+    "existing_file",
+    "flag",
     "is_real",
+    "pathname",
     "real",
+    "text",
     "time_step",
+    "unit",
     "whole",
 ]
 
@@ -59,6 +72,10 @@ MAX_DURATION = 86_400.0
 
 #: Longest zero padding added to either end of a record [s].
 MAX_PADDING = 600.0
+
+#: Largest magnitude of an azimuth accepted [deg] (one turn either way; an azimuth of 1e300 deg
+#: is a corrupt number, not a direction).
+MAX_AZIMUTH = 360.0
 
 _REAL_TYPES = (int, float, np.integer, np.floating)
 
@@ -262,3 +279,142 @@ def check_samples(arr: np.ndarray, name: str, limit: float = MAX_ACCELERATION) -
             f"{name} has {int(bad.sum())} sample(s) that are NaN, infinite or above the "
             f"plausibility limit {limit:g} m/s^2 ({limit / STANDARD_GRAVITY:g} g); the first is "
             f"{float(arr[i])!r} at index {i} ({what})")
+
+
+def azimuth(value, name: str) -> float:
+    """An azimuth [deg clockwise from north], checked to be a finite number within one turn.
+
+    Raises
+    ------
+    ParameterTypeError, ParameterError
+        Naming ``name``, if ``value`` is not a number in
+        [-:data:`MAX_AZIMUTH`, :data:`MAX_AZIMUTH`].
+    """
+    return real(value, name, low=-MAX_AZIMUTH, high=MAX_AZIMUTH, units="deg")
+
+
+def flag(value, name: str) -> bool:
+    """``value`` checked to be ``True`` or ``False`` (a Python or NumPy bool, nothing else).
+
+    Raises
+    ------
+    ParameterTypeError
+        Naming ``name``, for anything else (a string ``"yes"`` is not true).
+    """
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    raise ParameterTypeError(f"{name} must be True or False, got {type(value).__name__} "
+                             f"{value!r}")
+
+
+def text(value, name: str, *, optional: bool = False, what: str = "a non-empty string"):
+    """``value`` checked to be a non-empty string (or ``None`` when ``optional``).
+
+    Raises
+    ------
+    ParameterTypeError
+        Naming ``name``, if ``value`` is not a string.
+    ParameterError
+        If it is empty (or only blanks).
+    """
+    if value is None and optional:
+        return None
+    if not isinstance(value, str):
+        raise ParameterTypeError(f"{name} must be {what}"
+                                 f"{' or None' if optional else ''}, got "
+                                 f"{type(value).__name__} {value!r}")
+    if not value.strip():
+        raise ParameterError(f"{name} must be {what}, got {value!r}")
+    return value
+
+
+def pathname(value, name: str, what: str = "a file") -> str:
+    """``value`` (a ``str`` or :class:`os.PathLike`) as a ``str``, without looking at the disk.
+
+    Parameters
+    ----------
+    value : object
+        The argument.
+    name : str
+        Its name, for the message.
+    what : str
+        What it must name, for the message (``"a record file"``).
+
+    Raises
+    ------
+    ParameterTypeError
+        Naming ``name``, if ``value`` is not a path (None, a number, bytes...).
+    ParameterError
+        If it is an empty string.
+    """
+    path = os.fspath(value) if isinstance(value, os.PathLike) else value
+    if not isinstance(path, str):
+        raise ParameterTypeError(f"{name} must be a path (str or os.PathLike) naming {what}, "
+                                 f"got {type(value).__name__} {value!r}")
+    if not path.strip():
+        raise ParameterError(f"{name} must be a path naming {what}, got an empty string")
+    return path
+
+
+def existing_file(value, name: str, what: str = "a file", folder_hint: str = "") -> str:
+    """``value`` as a ``str`` path to an existing file (not a folder).
+
+    Parameters
+    ----------
+    value : object
+        The argument.
+    name : str
+        Its name, for the message.
+    what : str
+        What it must name (``"a StationXML file"``).
+    folder_hint : str
+        Said when the path is a folder (``"; read a folder with read_motions()"``).
+
+    Raises
+    ------
+    ParameterTypeError, ParameterError
+        As :func:`pathname`.
+    RecordError
+        Naming the path and ``name``, if nothing or a folder is there.
+    """
+    path = pathname(value, name, what)
+    if os.path.isdir(path):
+        raise RecordError(path, f"is a folder, not a file ({name} must name {what}"
+                                f"{folder_hint})")
+    if not os.path.exists(path):
+        raise RecordError(path, f"no such file ({name} must name {what})")
+    if not os.path.isfile(path):
+        raise RecordError(path, f"is not a regular file ({name} must name {what})")
+    return path
+
+
+def _unit_words(table) -> list[str]:
+    """The spellings of a unit table worth listing (``"m/s^2"``, not also ``"m/s**2"``)."""
+    return [u for u in table if "**" not in u and "/s/s" not in u]
+
+
+def unit(value, name: str, *, velocity: bool = True) -> str:
+    """``value`` checked to be a known unit of acceleration (or, if ``velocity``, of velocity).
+
+    Any spelling the record readers accept (``"G"``, ``"cm/sec2"``, ``"gal"``, ``"cm/s"``) is
+    accepted; it is returned unchanged.
+
+    Raises
+    ------
+    ParameterTypeError
+        Naming ``name``, if ``value`` is not a string.
+    ParameterError
+        If it is not a known unit; the message lists the known ones.
+    """
+    from shipblock.io._common import canonical_unit, canonical_velocity_unit
+
+    known = "an acceleration unit (" + ", ".join(_unit_words(ACCELERATION_UNITS_TO_SI)) + ")"
+    if velocity:
+        known += (" or a velocity unit (" + ", ".join(_unit_words(VELOCITY_UNITS_TO_SI))
+                  + "; with differentiate=True)")
+    if not isinstance(value, str):
+        raise ParameterTypeError(f"{name} must be {known}, got {type(value).__name__} "
+                                 f"{value!r}")
+    if canonical_unit(value) is None and not (velocity and canonical_velocity_unit(value)):
+        raise ParameterError(f"{name} must be {known}, got {value!r}")
+    return value

@@ -31,9 +31,10 @@ from pathlib import Path
 import obspy
 from obspy import Stream
 
-from shipblock.errors import RecordError, ShipblockError
+from shipblock import checks
+from shipblock.errors import ParameterError, RecordError, ShipblockError
 from shipblock.io import read_record
-from shipblock.motion import GroundMotion, read_motion, sensor_code
+from shipblock.motion import GroundMotion, check_read_arguments, read_motion, sensor_code
 
 __all__ = ["MotionSet", "expand_sources", "read_motions"]
 
@@ -78,27 +79,44 @@ class MotionSet:
         return self.motions[index]
 
 
-def expand_sources(source) -> list[Path]:
+_SOURCE = "a folder, glob pattern or record file"
+
+
+def expand_sources(source, name: str = "source") -> list[Path]:
     """Files named by a folder (recursively), a glob pattern, a file, or a list of them.
+
+    Parameters
+    ----------
+    source : str, os.PathLike, or list or tuple of them
+        What to expand.
+    name : str, optional
+        The argument's name, for messages.
 
     Raises
     ------
+    ParameterError
+        If ``source`` (or an item of a list, named ``source[i]``) is not a path (also a
+        :class:`TypeError`), or a list is empty.
     RecordError
         If a named file or folder does not exist, or a pattern matches nothing.
     """
     if isinstance(source, (list, tuple)):
-        return [path for item in source for path in expand_sources(item)]
-    name = os.fspath(source)
-    if os.path.isdir(name):
-        return sorted(p for p in Path(name).rglob("*") if p.is_file() and not p.name.startswith("."))
-    if os.path.isfile(name):
-        return [Path(name)]
-    if globbing.has_magic(name):
-        matches = sorted(Path(p) for p in globbing.glob(name, recursive=True) if os.path.isfile(p))
+        if not source:
+            raise ParameterError(f"{name} must be {_SOURCE} (str or os.PathLike), or a list of"
+                                 f" them, got an empty {type(source).__name__}")
+        return [path for i, item in enumerate(source)
+                for path in expand_sources(item, f"{name}[{i}]")]
+    path = checks.pathname(source, name, _SOURCE)
+    if os.path.isdir(path):
+        return sorted(p for p in Path(path).rglob("*") if p.is_file() and not p.name.startswith("."))
+    if os.path.isfile(path):
+        return [Path(path)]
+    if globbing.has_magic(path):
+        matches = sorted(Path(p) for p in globbing.glob(path, recursive=True) if os.path.isfile(p))
         if not matches:
-            raise RecordError(name, "the pattern matches no file")
+            raise RecordError(path, f"the pattern matches no file ({name} must name {_SOURCE})")
         return matches
-    raise RecordError(name, "no such file or folder")
+    raise RecordError(path, f"no such file or folder ({name} must name {_SOURCE})")
 
 
 def _xml_kind(path: Path) -> str | None:
@@ -209,10 +227,19 @@ def read_motions(source, inventory=None, units: str | None = None, *,
 
     Raises
     ------
+    ParameterError
+        Before any file is read, if an argument is of the wrong type or value, naming it (as
+        :func:`shipblock.motion.read_motion`: ``units="furlongs"``, ``response="partial"``...);
+        a wrong option is not a failure of every record.
     RecordError
-        If the source names nothing; a folder in which no file is readable gives an empty set
-        with every failure listed, not an error.
+        If the source names nothing, or an inventory or event path names no file; a folder in
+        which no file is readable gives an empty set with every failure listed, not an error.
     """
+    options = check_read_arguments(inventory=inventory, units=units, response=response,
+                                   differentiate=differentiate, align=align, gaps=gaps,
+                                   event=event)
+    inventory, event, differentiate = (options["inventory"], options["event"],
+                                       options["differentiate"])
     result = MotionSet()
     paths = expand_sources(source)
     inventories, events, waveforms = [], [], []

@@ -28,20 +28,22 @@ import logging
 import math
 import os
 import warnings
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 
 import numpy as np
 import obspy
 from obspy import Stream, Trace, UTCDateTime
 
-from shipblock.errors import ParameterError, RecordError, UnitsError
-from shipblock.io import read_record
+from shipblock import checks
+from shipblock.errors import ParameterError, ParameterTypeError, RecordError, UnitsError
+from shipblock.io import check_format, read_record
 from shipblock.io._common import (
     MAX_DIGITIZATION_GAP_S,
     canonical_unit,
     canonical_velocity_unit,
     check_count_value,
     check_plausible_samples,
+    check_sampling_interval,
     si_factor,
 )
 from shipblock.units import ACCELERATION_UNITS_TO_SI, STANDARD_GRAVITY, VELOCITY_UNITS_TO_SI
@@ -50,6 +52,7 @@ __all__ = [
     "COMPONENTS",
     "COMPONENT_KEY",
     "GroundMotion",
+    "check_read_arguments",
     "read_motion",
     "rotate_to_azimuth",
 ]
@@ -149,19 +152,26 @@ def rotate_to_azimuth(h1, h2, azimuth_h1: float, azimuth_h2: float, azimuth: flo
 
     Raises
     ------
-    ValueError
-        If the two horizontals are not orthogonal within :data:`ORIENTATION_TOLERANCE`, or an
-        azimuth is not finite.
+    ParameterError
+        Naming the argument: ``h1`` or ``h2`` not a one-dimensional array of finite
+        accelerations within 100 g (:func:`shipblock.checks.acceleration`), of different lengths;
+        an azimuth that is not a number within +-360 deg; or horizontals that are not orthogonal
+        within :data:`ORIENTATION_TOLERANCE` (``azimuth_h2``). A wrong type is also a
+        :class:`TypeError`.
     """
-    if not all(math.isfinite(float(a)) for a in (azimuth_h1, azimuth_h2, azimuth)):
-        raise ParameterError("azimuths must be finite numbers [deg]")
+    azimuth_h1 = checks.azimuth(azimuth_h1, "azimuth_h1")
+    azimuth_h2 = checks.azimuth(azimuth_h2, "azimuth_h2")
+    azimuth = checks.azimuth(azimuth, "azimuth")
     separation = (azimuth_h2 - azimuth_h1) % 360.0
     if min(abs(separation - 90.0), abs(separation - 270.0)) > ORIENTATION_TOLERANCE:
         raise ParameterError(
-            f"horizontals at {azimuth_h1:g} and {azimuth_h2:g} deg are not orthogonal"
+            f"azimuth_h2 must be 90 deg from azimuth_h1 (within {ORIENTATION_TOLERANCE:g} deg):"
+            f" horizontals at {azimuth_h1:g} and {azimuth_h2:g} deg are not orthogonal"
         )
-    h1 = np.asarray(h1, dtype=float)
-    h2 = np.asarray(h2, dtype=float)
+    h1 = checks.acceleration(h1, "h1", min_samples=1)
+    h2 = checks.acceleration(h2, "h2", min_samples=1)
+    if h2.size != h1.size:
+        raise ParameterError(f"h2 must have as many samples as h1 ({h1.size}), got {h2.size}")
     return h1 * math.cos(math.radians(azimuth - azimuth_h1)) + h2 * math.cos(
         math.radians(azimuth - azimuth_h2)
     )
@@ -183,6 +193,111 @@ def _check_finite(trace: Trace) -> None:
 
 
 # --------------------------------------------------------------------------------------------
+# Arguments
+# --------------------------------------------------------------------------------------------
+
+#: Choices of read_motion's options.
+RESPONSES = ("sensitivity", "full")
+GAPS = ("refuse", "interpolate")
+ALIGNS = ("trim", "resample", "strict")
+
+
+def check_read_arguments(*, inventory=None, units=None, response="sensitivity",
+                         differentiate=False, align="trim", gaps="refuse", event=None,
+                         format=None) -> dict:  # noqa: A002 - obspy's name for it
+    """Check the options :func:`read_motion` and :func:`shipblock.collection.read_motions` share.
+
+    Called before any file is read, so that a wrong option is one error naming it, not a
+    failure of every record (``read_motions`` lists failures per record).
+
+    Parameters
+    ----------
+    inventory, units, response, differentiate, align, gaps, event, format
+        As in :func:`read_motion`.
+
+    Returns
+    -------
+    dict
+        The arguments, paths as ``str`` and ``format`` in upper case.
+
+    Raises
+    ------
+    ParameterError
+        Naming the argument and what it expects (a :class:`~shipblock.errors.ParameterTypeError`,
+        also a :class:`TypeError`, for a wrong type): an unknown unit, response, alignment, gap
+        rule or format; ``differentiate`` not a bool; an empty event Catalog.
+    RecordError
+        Naming the file and the argument, if an inventory or event path names no file or a
+        folder.
+    """
+    if inventory is not None and not isinstance(inventory, obspy.Inventory):
+        if not isinstance(inventory, str | os.PathLike):
+            raise ParameterTypeError(
+                "inventory must be a StationXML file (str or os.PathLike), an obspy Inventory"
+                f" or None, got {type(inventory).__name__} {inventory!r}")
+        inventory = checks.existing_file(inventory, "inventory", "a StationXML file")
+    if units is not None:
+        checks.unit(units, "units")
+    checks.choice(response, "response", RESPONSES)
+    differentiate = checks.flag(differentiate, "differentiate")
+    checks.choice(align, "align", ALIGNS)
+    checks.choice(gaps, "gaps", GAPS)
+    if isinstance(event, obspy.Catalog):
+        if len(event) == 0:
+            raise ParameterError("event must hold an earthquake, got an empty obspy Catalog")
+    elif isinstance(event, str | os.PathLike):
+        event = checks.existing_file(event, "event", "a QuakeML event file")
+    elif not (event is None or isinstance(event, Mapping | obspy.core.event.Event)):
+        raise ParameterTypeError(
+            "event must be a QuakeML file (str or os.PathLike), an obspy Event or Catalog, a dict"
+            f" or None, got {type(event).__name__} {event!r}")
+    return dict(inventory=inventory, units=units, response=response,
+                differentiate=differentiate, align=align, gaps=gaps, event=event,
+                format=check_format(format))
+
+
+def _check_sources(paths_or_stream):
+    """``paths_or_stream`` of :func:`read_motion` checked: a Stream or Trace as given, a path
+    (file, folder or glob pattern) as a ``str``, or a non-empty list of existing files."""
+    if isinstance(paths_or_stream, Stream | Trace):
+        return paths_or_stream
+    expected = ("a record file, folder or glob pattern (str or os.PathLike), a list of record"
+                " files, or an obspy Stream or Trace")
+    if isinstance(paths_or_stream, str | os.PathLike):
+        path = checks.pathname(paths_or_stream, "paths_or_stream",
+                               "a record file, folder or glob pattern")
+        if _names_many(path):
+            return path
+        return checks.existing_file(path, "paths_or_stream", "a record file, folder or glob"
+                                    " pattern")
+    if (isinstance(paths_or_stream, bytes | Mapping | np.ndarray)
+            or not isinstance(paths_or_stream, Iterable)):
+        raise ParameterTypeError(f"paths_or_stream must be {expected}, got "
+                                 f"{type(paths_or_stream).__name__} {paths_or_stream!r}")
+    paths = list(paths_or_stream)
+    if not paths:
+        raise ParameterError(f"paths_or_stream must be {expected}, got an empty list")
+    return [checks.existing_file(p, f"paths_or_stream[{i}]", "a record file")
+            for i, p in enumerate(paths)]
+
+
+def _check_channel_map(channel_map):
+    """``channel_map`` checked: ``None`` or a mapping of strings to component names."""
+    if channel_map is None:
+        return None
+    if not isinstance(channel_map, Mapping):
+        raise ParameterTypeError(
+            "channel_map must be a dict {channel code, SEED id or file name: 'H1' | 'H2' | 'V'},"
+            f" got {type(channel_map).__name__} {channel_map!r}")
+    for key, value in channel_map.items():
+        if not isinstance(key, str):
+            raise ParameterTypeError(f"channel_map keys must be channel codes, SEED ids or file"
+                                     f" names (str), got {type(key).__name__} {key!r}")
+        checks.choice(value, f"channel_map[{key!r}]", COMPONENTS)
+    return dict(channel_map)
+
+
+# --------------------------------------------------------------------------------------------
 # Loading
 # --------------------------------------------------------------------------------------------
 
@@ -197,8 +312,6 @@ def _load_stream(paths_or_stream, units, fmt, read_kwargs) -> Stream:
         return _load_stream(Stream([paths_or_stream]), units, fmt, read_kwargs)
     single = isinstance(paths_or_stream, (str, os.PathLike))
     paths = [paths_or_stream] if single else list(paths_or_stream)
-    if not paths:
-        raise RecordError("<no files>", "no record files given")
     stream = Stream()
     for path in paths:
         stream += read_record(path, format=fmt, units=units, **read_kwargs)
@@ -208,9 +321,7 @@ def _load_stream(paths_or_stream, units, fmt, read_kwargs) -> Stream:
 def _load_inventory(inventory):
     if inventory is None or isinstance(inventory, obspy.Inventory):
         return inventory, ("<inventory>" if inventory is not None else None)
-    name = os.fspath(inventory)
-    if not os.path.isfile(name):
-        raise RecordError(name, "StationXML inventory: no such file")
+    name = os.fspath(inventory)  # an existing file: check_read_arguments
     try:
         return obspy.read_inventory(name), name
     except Exception as exc:  # noqa: BLE001 - any parser failure means a bad inventory file
@@ -233,7 +344,7 @@ def _load_event(event):
             raise RecordError(name, "holds no event")
         event = catalog[0]
     elif isinstance(event, obspy.Catalog):
-        event = event[0]
+        event = event[0]  # not empty: check_read_arguments
     origin = event.preferred_origin() or (event.origins[0] if event.origins else None)
     magnitude = event.preferred_magnitude() or (event.magnitudes[0] if event.magnitudes else None)
     summary = {"id": str(event.resource_id)}
@@ -929,8 +1040,11 @@ def _align(traces: list[Trace], align: str, notes: list[str]) -> None:
 
 
 def _validate(stream: Stream, label: str) -> dict[str, Trace]:
+    """The traces of a GroundMotion's stream by component, checked (see the class)."""
     traces = {}
     for trace in stream:
+        if not isinstance(trace, Trace):
+            raise ParameterTypeError(f"stream must hold obspy Traces, got a {type(trace).__name__}")
         component = trace.stats.get(COMPONENT_KEY)
         if component not in COMPONENTS:
             raise RecordError(
@@ -941,6 +1055,9 @@ def _validate(stream: Stream, label: str) -> dict[str, Trace]:
         if trace.stats.get("units", _SI_UNITS) != _SI_UNITS:
             raise UnitsError(label, f"trace {component} is in {trace.stats.units}, not m/s**2")
         _check_finite(trace)
+        check_sampling_interval(trace.stats.delta, label, f"{component} ({trace.id}): sampling"
+                                                          " interval")
+        check_plausible_samples(np.asarray(trace.data), label, f"{component} ({trace.id})")
         traces[component] = trace
     if "H1" not in traces and "H2" not in traces:
         raise RecordError(label, "no horizontal component")
@@ -957,6 +1074,17 @@ def _validate(stream: Stream, label: str) -> dict[str, Trace]:
             raise RecordError(label, f"{component} starts at {trace.stats.starttime}, not "
                                      f"{first.stats.starttime}")
     return traces
+
+
+def _samples(values, name: str, factor: float, units: str) -> np.ndarray:
+    """An array argument of :meth:`GroundMotion.from_arrays` in m/s^2, checked (a copy)."""
+    raw = checks.as_real_array(values, name, f"a one-dimensional array of accelerations [{units}]")
+    if raw.ndim != 1:
+        raise ParameterError(f"{name} must be a one-dimensional (1-D) array, got shape "
+                             f"{raw.shape}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        data = np.array(raw, dtype=np.float64) * factor
+    return checks.acceleration(data, name if factor == 1.0 else f"{name} (in m/s^2, from {units})")
 
 
 class GroundMotion:
@@ -980,21 +1108,39 @@ class GroundMotion:
 
     Raises
     ------
+    ParameterError
+        If an argument is of the wrong type (also a :class:`TypeError`: a stream that is not an
+        obspy Stream, metadata that is not a dict) or value (an azimuth that is not a number
+        within +-360 deg, a horizontal other than H1/H2, or both given).
     RecordError
-        If the stream is not tagged, not aligned, not in m/s^2, or holds NaN/inf samples.
+        If the stream is not tagged, not aligned, not in m/s^2, or holds NaN/inf samples,
+        samples above 100 g (:data:`shipblock.checks.MAX_ACCELERATION`) or a sampling interval
+        outside 1e-4..1 s.
     """
 
     def __init__(self, stream: Stream, metadata: dict | None = None, azimuth=None,
                  horizontal=None):
+        if not isinstance(stream, Stream):
+            raise ParameterTypeError(
+                f"stream must be an obspy Stream of traces tagged stats.{COMPONENT_KEY}, got "
+                f"{type(stream).__name__} {stream!r}"[:300])
+        if not (metadata is None or isinstance(metadata, Mapping)):
+            raise ParameterTypeError(f"metadata must be a dict or None, got "
+                                     f"{type(metadata).__name__} {metadata!r}"[:300])
+        if azimuth is not None:
+            azimuth = checks.azimuth(azimuth, "azimuth")
+        if horizontal is not None:
+            checks.choice(horizontal, "horizontal", ("H1", "H2"))
         if azimuth is not None and horizontal is not None:
-            raise ParameterError("give azimuth= or horizontal=, not both")
-        if horizontal is not None and horizontal not in ("H1", "H2"):
-            raise ParameterError(f"horizontal must be 'H1' or 'H2', not {horizontal!r}")
+            raise ParameterError("azimuth and horizontal exclude each other: give azimuth= or"
+                                 " horizontal=, not both")
         self._metadata = dict(metadata or {})
-        label = ", ".join(self._metadata.get("source_files", [])) or "<stream>"
+        files = self._metadata.get("source_files") or []
+        label = (", ".join(str(f) for f in files) if isinstance(files, list | tuple)
+                 else str(files)) or "<stream>"
         self._traces = _validate(stream, label)
         self._stream = stream
-        self._azimuth = None if azimuth is None else float(azimuth)
+        self._azimuth = azimuth
         self._horizontal = horizontal
         self._label = label
 
@@ -1027,23 +1173,31 @@ class GroundMotion:
 
         Raises
         ------
-        RecordError
-            If the arrays are empty, of different lengths, not 1-D, or hold NaN/inf; or ``dt`` is
-            not positive.
-        UnitsError
-            If ``units`` is unknown.
+        ParameterError
+            Naming the argument (a :class:`~shipblock.errors.ParameterTypeError`, also a
+            :class:`TypeError`, for a wrong type): ``horizontal`` or ``vertical`` not a
+            one-dimensional array of at least two real numbers, holding NaN/inf or a sample
+            above 100 g once in m/s^2, or of different lengths; ``dt`` outside 1e-4..1 s; an
+            unknown ``units``; ``name`` not a non-empty string; ``azimuth_h1`` not a number
+            within +-360 deg.
         """
+        name = checks.text(name, "name")
+        units = checks.unit(units, "units", velocity=False)
         factor = si_factor(units, name)
-        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-            raise RecordError(name, f"dt={dt!r} s is not a positive number")
-        arrays = {"H1": horizontal} if vertical is None else {"H1": horizontal, "V": vertical}
+        dt = checks.time_step(dt, "dt")
+        if azimuth_h1 is not None:
+            azimuth_h1 = checks.azimuth(azimuth_h1, "azimuth_h1")
+        arrays = {"H1": _samples(horizontal, "horizontal", factor, units)}
+        if vertical is not None:
+            arrays["V"] = _samples(vertical, "vertical", factor, units)
+            if arrays["V"].size != arrays["H1"].size:
+                raise ParameterError(f"vertical must have as many samples as horizontal"
+                                     f" ({arrays['H1'].size}), got {arrays['V'].size}: the"
+                                     " horizontal and vertical arrays differ in length")
         stream = Stream()
-        for component, values in arrays.items():
-            data = np.array(values, dtype=np.float64, copy=True)
-            if data.ndim != 1:
-                raise RecordError(name, f"{component} must be a 1-D array, not {data.ndim}-D")
-            trace = Trace(data=data * factor)
-            trace.stats.delta = float(dt)
+        for component, data in arrays.items():
+            trace = Trace(data=data)
+            trace.stats.delta = dt
             trace.stats.station = name[:64]
             trace.stats.channel = "HNZ" if component == "V" else "HN1"
             trace.stats[COMPONENT_KEY] = component
@@ -1053,8 +1207,6 @@ class GroundMotion:
             if component == "H1" and azimuth_h1 is not None:
                 trace.stats.azimuth = float(azimuth_h1)
             stream += trace
-        if len(stream) == 2 and stream[0].stats.npts != stream[1].stats.npts:
-            raise RecordError(name, "horizontal and vertical arrays differ in length")
         metadata = {
             "station": {"name": name},
             "event": None,
@@ -1086,9 +1238,16 @@ class GroundMotion:
         -------
         GroundMotion
             A new object; this one is unchanged.
+
+        Raises
+        ------
+        ParameterError
+            If ``stream`` is not an obspy Stream or ``note`` not a non-empty string (also a
+            :class:`TypeError`); RecordError as the class does for a stream it cannot hold.
         """
+        note = checks.text(note, "note")
         metadata = copy.deepcopy(self._metadata)
-        metadata.setdefault("processing", []).append(str(note))
+        metadata.setdefault("processing", []).append(note)
         return GroundMotion(stream, metadata, azimuth=self._azimuth, horizontal=self._horizontal)
 
     # -- data ---------------------------------------------------------------------------------
@@ -1224,6 +1383,10 @@ def _one_of_folder(source, inventory, units, response, differentiate, align, gap
     label = os.fspath(source)
     failures = "".join(f"\n  {where}: {why}" for where, why in found.failures)
     if not motions:
+        if not found.motions and not found.failures:
+            raise RecordError(label, f"holds no record file, only {len(found.skipped)} files"
+                              " that are not waveforms" if found.skipped else
+                              "holds no file (an empty folder)")
         raise RecordError(label, "no record could be read from it"
                           + (f" for sensor {sensor!r}" if sensor else "") + ":" + failures)
     if len(motions) > 1:
@@ -1317,21 +1480,40 @@ def read_motion(
 
     Raises
     ------
+    ParameterError
+        Before any file is read, naming the argument and what it expects (a
+        :class:`~shipblock.errors.ParameterTypeError`, also a :class:`TypeError`, for a wrong
+        type): a source that is not a path, list of paths, Stream or Trace; an unknown unit
+        (``units="furlongs"``), response, alignment, gap rule or format; an azimuth that is not a
+        number within +-360 deg; a horizontal other than H1/H2, or both; a channel_map that is
+        not a dict of components; ``differentiate`` not a bool; ``sensor`` not a string, or one
+        the record does not hold; a reader keyword such as ``dt`` out of range.
     RecordError
-        For unreadable, corrupt or truncated files, unknown formats, NaN/inf samples, empty traces,
-        gaps, overlapping records with different samples, components of different rates or
-        windows (beyond the tolerances above), accelerations above 100 g, a sensitivity or
-        calibration that is not a number an instrument has, missing horizontals, or an inventory
-        that does not match.
+        For a path (record, inventory or event) that names no file, or a folder where a file is
+        needed (the message names the argument); for unreadable, corrupt or truncated files,
+        unknown formats, NaN/inf samples, empty traces, gaps, overlapping records with different
+        samples, components of different rates or windows (beyond the tolerances above),
+        accelerations above 100 g, a sensitivity or calibration that is not a number an
+        instrument has, missing horizontals, or an inventory that does not match.
     UnitsError
         If the units of a trace are unknown or contradictory.
     """
+    options = check_read_arguments(inventory=inventory, units=units, response=response,
+                                   differentiate=differentiate, align=align, gaps=gaps,
+                                   event=event, format=format)
+    inventory, event, format = options["inventory"], options["event"], options["format"]
+    differentiate = options["differentiate"]
+    if azimuth is not None:
+        azimuth = checks.azimuth(azimuth, "azimuth")
+    if horizontal is not None:
+        checks.choice(horizontal, "horizontal", ("H1", "H2"))
     if azimuth is not None and horizontal is not None:
-        raise ParameterError("give azimuth= or horizontal=, not both")
-    if align not in ("trim", "resample", "strict"):
-        raise ParameterError(f"align must be 'trim', 'resample' or 'strict', not {align!r}")
-    if gaps not in ("refuse", "interpolate"):
-        raise ParameterError(f"gaps must be 'refuse' or 'interpolate', not {gaps!r}")
+        raise ParameterError("azimuth and horizontal exclude each other: give azimuth= or"
+                             " horizontal=, not both")
+    channel_map = _check_channel_map(channel_map)
+    sensor = checks.text(sensor, "sensor", optional=True,
+                         what="a sensor code such as 'HN' or '02.HN'")
+    paths_or_stream = _check_sources(paths_or_stream)
     if _names_many(paths_or_stream):
         return _one_of_folder(paths_or_stream, inventory, units, response, differentiate, align,
                               gaps, event, azimuth, horizontal, sensor)

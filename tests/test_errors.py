@@ -1,6 +1,8 @@
 """Bad input raises the project's own errors: one ``except ShipblockError`` catches them all,
 and they stay ValueErrors for code that expects the conventional type."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -13,6 +15,7 @@ from shipblock import (
     simulate_batch,
     system_restitution,
 )
+from shipblock.checks import MAX_ACCELERATION
 from shipblock.errors import ParameterError, ParameterTypeError, RecordError, ShipblockError
 from shipblock.fragility.design import AnalysisDesign, IntensityDesign
 from shipblock.fragility.fit import fit_mle
@@ -330,3 +333,249 @@ def test_every_public_function_accepts_or_names_a_bad_argument(function):
                 if not _finite(out):
                     problems.append(f"{arg}={label}: accepted with a non-finite result")
     assert not problems, "\n".join(problems)
+
+
+# -------------------------------------------------------------------------------------------
+# the reader-side entry points, every argument, garbage
+# -------------------------------------------------------------------------------------------
+
+DATA = Path(__file__).parent / "data"
+#: Three one-component PEER files of 7 samples: H1 (180 deg), H2 (270 deg) and V.
+HELENA = [str(DATA / f"helena_synthetic_{c}.AT2") for c in ("180", "270", "dwn")]
+
+
+def _reader_calls():
+    from shipblock.catalogue import catalogue_toml, default_catalogue_path, load_catalogue
+    from shipblock.collection import expand_sources, read_motions
+    from shipblock.io import read_record
+    from shipblock.motion import GroundMotion, read_motion, rotate_to_azimuth
+
+    acc = 2.0 * np.sin(np.linspace(0.0, 20.0, 400))
+    acc2 = np.cos(np.linspace(0.0, 20.0, 400))
+    motion = GroundMotion.from_arrays(acc, acc2, dt=0.01, name="sine")
+    return {
+        "read_record": (read_record, dict(path=HELENA[0], format=None, units=None, dt=None)),
+        "read_motion": (read_motion, dict(paths_or_stream=HELENA, inventory=None, units=None,
+                                          azimuth=30.0, horizontal=None,
+                                          response="sensitivity", channel_map=None, event=None,
+                                          gaps="refuse", align="trim", format=None,
+                                          differentiate=False, sensor=None)),
+        "read_motions": (read_motions, dict(source=HELENA, inventory=None, units=None,
+                                            response="sensitivity", differentiate=False,
+                                            align="trim", gaps="refuse", event=None)),
+        "expand_sources": (expand_sources, dict(source=HELENA)),
+        "load_catalogue": (load_catalogue, dict(path=default_catalogue_path())),
+        "catalogue_toml": (catalogue_toml, dict(motions=read_motions(HELENA),
+                                                output="catalogue.toml", licence="CC0",
+                                                credit="synthetic", units=None)),
+        "from_arrays": (GroundMotion.from_arrays, dict(horizontal=acc, vertical=acc2, dt=0.01,
+                                                      units="m/s^2", name="sine",
+                                                      azimuth_h1=None)),
+        "GroundMotion": (GroundMotion, dict(stream=motion.stream, metadata=motion.metadata,
+                                            azimuth=None, horizontal="H1")),
+        "with_stream": (motion.with_stream, dict(stream=motion.stream, note="scaled x2")),
+        "rotate_to_azimuth": (rotate_to_azimuth, dict(h1=acc, h2=acc2, azimuth_h1=0.0,
+                                                      azimuth_h2=90.0, azimuth=30.0)),
+    }
+
+
+#: Garbage for the reader arguments on top of GARBAGE: the values issue #23 names.
+READER_GARBAGE = {**GARBAGE, "unknown word": "furlongs", "sensor XX": "XX",
+                  "response partial": "partial", "a folder": str(DATA / "reference"),
+                  "a missing file": str(DATA / "no_such_record.AT2"), "empty string": "",
+                  "a Path": DATA / "no_such_record.AT2", "negative int": -5,
+                  "dict": {"H1": "X"}}
+
+
+@pytest.mark.filterwarnings("ignore")
+@pytest.mark.parametrize("function", list(_reader_calls()))
+def test_every_reader_entry_point_accepts_or_names_a_bad_argument(function, tmp_path,
+                                                                 monkeypatch):
+    """The same rule for the reader side: read_record, read_motion, read_motions,
+    load_catalogue, catalogue_toml, GroundMotion and its constructors: each argument replaced
+    in turn by garbage (wrong types, NaN/inf, 1e300, unknown words, missing files, folders)
+    gives a good result or a shipblock error (or TypeError) whose message names the argument."""
+    from obspy import Stream
+
+    from shipblock.motion import GroundMotion
+
+    monkeypatch.chdir(tmp_path)  # 'abc' or 'furlongs' must name no file
+    fn, good = _reader_calls()[function]
+
+    def fresh(value):
+        return value.copy() if isinstance(value, Stream) else value
+
+    fn(**{k: fresh(v) for k, v in good.items()})
+    problems, refused = [], 0
+    for arg in good:
+        for label, bad in READER_GARBAGE.items():
+            args = {k: fresh(v) for k, v in good.items()}
+            args[arg] = bad
+            try:
+                out = fn(**args)
+            except (ShipblockError, TypeError) as exc:
+                refused += 1
+                # a folder that exists but holds no usable record is a record problem: named
+                # by the folder, the way every record error names its file
+                about_the_folder = (isinstance(exc, RecordError) and label == "a folder"
+                                    and exc.source == str(bad))
+                if arg not in str(exc) and not about_the_folder:
+                    problems.append(f"{arg}={label}: {type(exc).__name__} does not name it: "
+                                    f"{exc}")
+            except Exception as exc:  # noqa: BLE001 - the failure under test
+                problems.append(f"{arg}={label}: {type(exc).__name__}: {exc}")
+            else:
+                if isinstance(out, GroundMotion) and not all(
+                        np.isfinite(c).all() and np.abs(c).max() <= MAX_ACCELERATION
+                        for c in out.components.values()):
+                    problems.append(f"{arg}={label}: accepted with samples NaN or above 100 g")
+                elif not _finite(out):
+                    problems.append(f"{arg}={label}: accepted with a non-finite result")
+    assert not problems, "\n".join(problems)
+    assert refused >= len(good) * 8  # most garbage is refused, not quietly taken
+
+
+READER_CASES = {
+    "units furlongs": (lambda: _read(units="furlongs"), ParameterError,
+                       "units must be an acceleration unit .*'furlongs'"),
+    "units not a string": (lambda: _read(units=9.81), ParameterTypeError, "units"),
+    "sensor XX": (lambda: _read(sensor="XX"), ParameterError, "sensor='XX' matches none"),
+    "response partial": (lambda: _read(response="partial"), ParameterError,
+                         "response must be one of 'sensitivity', 'full', got 'partial'"),
+    "azimuth NaN": (lambda: _read(azimuth=float("nan")), ParameterError,
+                    r"azimuth must be a number in \[-360, 360\] \[deg\], got nan"),
+    "azimuth 1e300": (lambda: _read(azimuth=1e300), ParameterError, "azimuth"),
+    "azimuth and horizontal": (lambda: _read(azimuth=0.0, horizontal="H1"), ParameterError,
+                               "not both"),
+    "horizontal H3": (lambda: _read(horizontal="H3"), ParameterError, "horizontal"),
+    "differentiate 'yes'": (lambda: _read(differentiate="yes"), ParameterTypeError,
+                            "differentiate must be True or False"),
+    "channel_map list": (lambda: _read(channel_map=["HN1"]), ParameterTypeError,
+                         "channel_map must be a dict"),
+    "channel_map value": (lambda: _read(channel_map={"180": "X"}), ParameterError,
+                          r"channel_map\['180'\] must be one of 'H1', 'H2', 'V'"),
+    "format unknown": (lambda: _read(format="SEISMO"), ParameterError,
+                       "format must be None .*MSEED.*SHIPBLOCK_AT2.*got 'SEISMO'"),
+    "dt of a text file NaN": (lambda: _read(dt=float("nan")), ParameterError, "dt must be"),
+    "missing record": (lambda: _read(DATA / "no_such.AT2"), RecordError,
+                       "no_such.AT2: no such file .paths_or_stream must name"),
+    "record is a folder in a list": (lambda: _read([HELENA[0], DATA]), RecordError,
+                                     r"is a folder, not a file .paths_or_stream\[1\]"),
+    "no record": (lambda: _read([]), ParameterError, "paths_or_stream .* got an empty list"),
+    "record None": (lambda: _read(None), ParameterTypeError, "paths_or_stream must be"),
+    "inventory is a folder": (lambda: _read(inventory=DATA), RecordError,
+                              "is a folder, not a file .inventory must name a StationXML"),
+    "inventory missing": (lambda: _read(inventory="nothere.xml"), RecordError,
+                          "nothere.xml: no such file .inventory"),
+    "event of a number": (lambda: _read(event=7), ParameterTypeError, "event must be"),
+    "event missing": (lambda: _read(event="nothere.xml"), RecordError, "no such file .event"),
+    "empty folder": (lambda: _read(Path.cwd()), RecordError, "holds no file .an empty folder"),
+    "read_motions response": (lambda: _read_all(response="partial"), ParameterError,
+                              "response"),
+    "read_motions units": (lambda: _read_all(units="furlongs"), ParameterError, "units"),
+    "read_motions no source": (lambda: _read_all(source=None), ParameterTypeError,
+                               "source must be a path"),
+    "read_motions missing source": (lambda: _read_all(source="nothere/"), RecordError,
+                                    "nothere/: no such file or folder .source"),
+    "read_record folder": (lambda: _record(DATA), RecordError,
+                           "is a folder, not a file .path must name a record file"),
+    "read_record None": (lambda: _record(None), ParameterTypeError, "path must be a path"),
+    "read_record units": (lambda: _record(HELENA[0], units="furlongs"), ParameterError,
+                          "units"),
+    "read_record resample_rate": (lambda: _record(HELENA[0], resample_rate=0.0),
+                                  ParameterError, r"resample_rate must be a number in \[1, "),
+    "catalogue folder": (lambda: _catalogue(DATA), RecordError,
+                         "is a folder, not a file .path must name a catalogue"),
+    "catalogue number": (lambda: _catalogue(5), ParameterTypeError, "path must be a path"),
+    "catalogue entry units": (lambda: _entry().read(units="g"), ParameterError,
+                              "units is set by the catalogue entry 'south-napa-2014/NP.1737'"),
+    "catalogue entry azimuth": (lambda: _entry().read(azimuth="N"), ParameterTypeError,
+                                "azimuth must be a number"),
+    "from_arrays 100 g": (lambda: _arrays(ACC * 1e3), ParameterError,
+                          "horizontal has .* above the plausibility limit .*100 g"),
+    "from_arrays 200 g in g": (lambda: _arrays(ACC * 200.0, units="g"), ParameterError,
+                               r"horizontal \(in m/s\^2, from g\) has"),
+    "from_arrays NaN vertical": (lambda: _arrays(ACC, np.r_[ACC[:-1], np.nan]), ParameterError,
+                                 "vertical has 1 sample.*nan at index 499"),
+    "from_arrays dt 1e-300": (lambda: _arrays(ACC, dt=1e-300), ParameterError,
+                              r"dt must be a number in \[0.0001, 1\] \[s\], got 1e-300"),
+    "from_arrays dt 1e300": (lambda: _arrays(ACC, dt=1e300), ParameterError, "dt must be"),
+    "from_arrays dt None": (lambda: _arrays(ACC, dt=None), ParameterTypeError, "dt must be"),
+    "from_arrays one sample": (lambda: _arrays([1.0]), ParameterError,
+                               "horizontal must have at least 2 samples"),
+    "from_arrays units furlongs": (lambda: _arrays(ACC, units="furlongs"), ParameterError,
+                                   "units must be an acceleration unit"),
+    "from_arrays velocity units": (lambda: _arrays(ACC, units="cm/s"), ParameterError,
+                                   "units must be an acceleration unit"),
+    "GroundMotion of a list": (lambda: _gm_class()([ACC]), ParameterTypeError,
+                               "stream must be an obspy Stream"),
+    "GroundMotion above 100 g": (lambda: _gm_class()(_stream_of(ACC * 1e3)), RecordError,
+                                 "H1 .* has a sample of .* not a ground acceleration"),
+    "GroundMotion dt 1e-30": (lambda: _gm_class()(_stream_of(ACC, delta=1e-30)), RecordError,
+                              "sampling interval 1e-30 s is outside"),
+}
+
+
+_HELENA = object()
+
+
+def _read(source=_HELENA, **kwargs):
+    from shipblock.motion import read_motion
+
+    return read_motion(HELENA if source is _HELENA else source, **kwargs)
+
+
+def _read_all(source=HELENA, **kwargs):
+    from shipblock.collection import read_motions
+
+    return read_motions(source, **kwargs)
+
+
+def _record(path, **kwargs):
+    from shipblock.io import read_record
+
+    return read_record(path, **kwargs)
+
+
+def _catalogue(path):
+    from shipblock.catalogue import load_catalogue
+
+    return load_catalogue(path)
+
+
+def _entry():
+    from shipblock.catalogue import load_catalogue
+
+    return load_catalogue()["south-napa-2014/NP.1737"]
+
+
+def _arrays(horizontal, vertical=None, **kwargs):
+    from shipblock.motion import GroundMotion
+
+    return GroundMotion.from_arrays(horizontal, vertical, **kwargs)
+
+
+def _gm_class():
+    from shipblock.motion import GroundMotion
+
+    return GroundMotion
+
+
+def _stream_of(data, delta=0.01):
+    from obspy import Stream, Trace
+
+    from shipblock.motion import COMPONENT_KEY
+
+    trace = Trace(np.asarray(data, dtype=float))
+    trace.stats.delta = delta
+    trace.stats[COMPONENT_KEY] = "H1"
+    return Stream([trace])
+
+
+@pytest.mark.filterwarnings("ignore")
+@pytest.mark.parametrize("case", list(READER_CASES))
+def test_reader_arguments_of_issue_23_raise_a_named_error(case, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    make, kind, message = READER_CASES[case]
+    with pytest.raises(kind, match=message):
+        make()

@@ -3,7 +3,10 @@
 Whatever arguments hypothesis makes up for :class:`~shipblock.ShipBlockSystem`,
 :func:`~shipblock.simulate` and :func:`~shipblock.simulate_batch`, the call either returns a
 result with finite summaries or raises a :class:`~shipblock.errors.ParameterError` that names
-the argument at fault: never another exception type, a NaN result or a hang. An oracle written
+the argument at fault: never another exception type, a NaN result or a hang. The reader side
+(:func:`~shipblock.read_motion`, :func:`~shipblock.read_record`,
+:meth:`~shipblock.GroundMotion.from_arrays`, :func:`~shipblock.rotate_to_azimuth`,
+:func:`~shipblock.load_catalogue`) is held to the same rule on three 7-sample PEER files. An oracle written
 from the documented limits (:data:`shipblock.system.FIELD_LIMITS`, :mod:`shipblock.checks`)
 says which arguments are wrong, so a message naming a good argument fails the test too.
 
@@ -14,7 +17,12 @@ solver is compiled (the compilation is shared with the other solver tests).
 from __future__ import annotations
 
 import math
+import os
+import re
+import shutil
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,9 +30,14 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from shipblock import ShipBlockSystem, simulate, simulate_batch
+from shipblock.catalogue import load_catalogue
 from shipblock.checks import MAX_ACCELERATION, MAX_TIME_STEP, MIN_TIME_STEP
-from shipblock.errors import ParameterError, ShipblockError
+from shipblock.errors import ParameterError, RecordError, ShipblockError
+from shipblock.io import read_record
+from shipblock.io._common import canonical_unit, canonical_velocity_unit
+from shipblock.motion import GroundMotion, read_motion, rotate_to_azimuth
 from shipblock.system import FIELD_LIMITS, MIN_INERTIA_RATIO
+from shipblock.units import ACCELERATION_UNITS_TO_SI
 
 SETTINGS = settings(max_examples=300, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow])
@@ -118,7 +131,8 @@ def run(call):
     except Exception as exc:  # noqa: BLE001 - what is raised is what is tested
         out, err = None, exc
     assert time.perf_counter() - t0 < SLOW, "a hang"
-    event("accepted" if err is None else f"refused: {str(err).split()[0].split('[')[0]}")
+    event("accepted" if err is None else f"refused: {type(err).__name__}"
+          if isinstance(err, RecordError) else f"refused: {str(err).split()[0].split('[')[0]}")
     return out, err
 
 
@@ -336,3 +350,301 @@ def test_any_valid_system_and_record_give_finite_results(system, ax, ay, dt):
     out, err = run(lambda: simulate_batch(system, [(ax, ay)], dt, [[0, 0, 1.0, 1.0]]))
     assert err is None, f"{type(err).__name__}: {err}"
     assert out["peak_block_slip"][0] == res.summary["peak_block_slip"]
+
+
+# -------------------------------------------------------------------------------------------
+# the reader side: read_motion, read_record, GroundMotion.from_arrays, rotate_to_azimuth,
+# load_catalogue
+# -------------------------------------------------------------------------------------------
+
+READER_SETTINGS = settings(max_examples=80, deadline=None, derandomize=True,
+                           suppress_health_check=[HealthCheck.too_slow])
+
+DATA = Path(__file__).parent / "data"
+#: Three one-component PEER files of 7 samples (g): H1 (channel 180), H2 (270) and V (DWN).
+HELENA = [str(DATA / f"helena_synthetic_{c}.AT2") for c in ("180", "270", "dwn")]
+
+GOOD_UNITS = ["g", "G", "m/s^2", "cm/s2", "gal", "mg", "cm/s", "M/S"]
+BAD_WORDS = ["furlongs", "", "g/100", "%g", "xx", "XX", "H3", "partial", "fill", "yes"]
+WORDS = st.sampled_from(GOOD_UNITS + BAD_WORDS)
+
+
+def first_name(exc: Exception) -> str:
+    """The argument a message starts with (``"sensor='XX' matches..."`` -> ``"sensor"``)."""
+    return re.match(r"[A-Za-z_][A-Za-z_0-9]*", str(exc)).group(0)
+
+
+def a_unit(value, velocity=True) -> bool:
+    if not isinstance(value, str):
+        return False
+    acceleration = canonical_unit(value) is not None
+    return acceleration or (velocity and canonical_velocity_unit(value) is not None)
+
+
+def good_samples(x, min_size: int) -> bool:
+    """Whether ``x`` is a 1-D array of at least ``min_size`` real numbers (any size)."""
+    if x is None or isinstance(x, str | bytes | dict):
+        return False
+    try:
+        arr = np.asarray(x)
+    except Exception:  # noqa: BLE001
+        return False
+    return arr.dtype.kind in "iuf" and arr.ndim == 1 and arr.size >= min_size
+
+
+def an_azimuth(value) -> bool:
+    return good_real(value, -360.0, 360.0)
+
+
+def one_of(value, choices) -> bool:
+    return isinstance(value, str) and value in choices
+
+
+AZIMUTH = st.one_of(st.none(), st.floats(-360.0, 360.0), st.integers(-400, 400), EXTREMES,
+                    GARBAGE)
+
+
+def option(good, bad):
+    """One of the ``good`` values six times in seven, else a bad one or garbage."""
+    return mostly(st.sampled_from(good), st.one_of(st.sampled_from(bad), GARBAGE), 6)
+
+
+#: An azimuth, mostly a good one (None is not an azimuth here).
+ANGLE = mostly(st.floats(-360.0, 360.0) | st.integers(-360, 360),
+               st.one_of(st.none(), EXTREMES, GARBAGE, st.integers(361, 10**6)), 6)
+
+
+@READER_SETTINGS
+@pytest.mark.filterwarnings("ignore")
+@given(units=mostly(st.none() | st.sampled_from(["g", "G"]), st.one_of(WORDS, GARBAGE), 6),
+       azimuth=mostly(st.none() | st.floats(-360.0, 360.0), AZIMUTH, 6),
+       horizontal=option([None, None, "H1", "H2"], ["H3", "h1", ""]),
+       response=option(["sensitivity", "full"], ["partial", "Full", ""]),
+       gaps=option(["refuse", "interpolate"], ["fill", ""]),
+       align=option(["trim", "resample", "strict"], ["pad", ""]),
+       differentiate=option([False, True], ["yes", 1, 0.0]),
+       sensor=mostly(st.none(), st.one_of(WORDS, GARBAGE), 4),
+       fmt=option([None, None, "SHIPBLOCK_AT2", "shipblock_at2", "MSEED"], ["AT2", "XYZ", ""]),
+       channel_map=option([None, {"180": "H1", "270": "H2"}, {"180": "H2", "DWN": "V"}],
+                          [{"180": "X"}, {1: "H1"}, ["180"], {"180": None}]),
+       source=mostly(st.sampled_from([HELENA, HELENA[:2], HELENA[0], str(DATA / "reference")]),
+                     st.sampled_from([None, [], "no_such.AT2", [HELENA[0], None], 5]), 5))
+def test_read_motion_reads_or_names_the_argument(units, azimuth, horizontal, response, gaps,
+                                                 align, differentiate, sensor, fmt,
+                                                 channel_map, source):
+    """read_motion with options drawn good or bad: a GroundMotion within the plausibility
+    limits, a record error when every argument is good (the record and the options may not
+    suit each other: units= contradicting the file's g, one horizontal and an azimuth...), or
+    an error naming a wrong argument: never another exception."""
+    out, err = run(lambda: read_motion(source, units=units, azimuth=azimuth,
+                                       horizontal=horizontal, response=response, gaps=gaps,
+                                       align=align, differentiate=differentiate, sensor=sensor,
+                                       format=fmt, channel_map=channel_map))
+    # 'bad': wrong before any file is read; a sensor code is known wrong only once the record is
+    # read (no code matches a PEER file's channels), after a record error, if any
+    bad = set()
+    if source not in (HELENA, HELENA[:2], HELENA[0], str(DATA / "reference")):
+        bad.add("paths_or_stream")
+    if units is not None and not a_unit(units):
+        bad.add("units")
+    if azimuth is not None and not an_azimuth(azimuth):
+        bad.add("azimuth")
+    if horizontal is not None and not one_of(horizontal, ("H1", "H2")):
+        bad.add("horizontal")
+    if azimuth is not None and horizontal is not None:
+        bad.add("azimuth")
+    for name, value, choices in (("response", response, ("sensitivity", "full")),
+                                 ("gaps", gaps, ("refuse", "interpolate")),
+                                 ("align", align, ("trim", "resample", "strict"))):
+        if not one_of(value, choices):
+            bad.add(name)
+    if not isinstance(differentiate, bool):
+        bad.add("differentiate")
+    if sensor is not None and not (isinstance(sensor, str) and sensor.strip()):
+        bad.add("sensor")
+    if fmt is not None and not (isinstance(fmt, str) and fmt.upper() in ("SHIPBLOCK_AT2",
+                                                                         "MSEED")):
+        bad.add("format")
+    if channel_map is not None and not (
+            isinstance(channel_map, dict) and all(isinstance(k, str) and v in ("H1", "H2", "V")
+                                                  for k, v in channel_map.items())):
+        bad.add("channel_map")
+    if err is None:
+        assert not bad and sensor is None, f"accepted {sorted(bad)}, sensor={sensor!r}"
+        for values in out.components.values():
+            assert np.isfinite(values).all() and np.abs(values).max() <= MAX_ACCELERATION
+        assert MIN_TIME_STEP <= out.dt <= MAX_TIME_STEP
+        if azimuth is not None and {"H1", "H2"} <= set(out.components):
+            # the projection of (H1 at 180 deg, H2 at 270 deg: the files' channels) on the
+            # azimuth, by hand
+            assert out.azimuths == {"H1": 180.0, "H2": 270.0}
+            a = math.radians(float(azimuth))
+            expected = (out.components["H1"] * math.cos(a - math.pi)
+                        + out.components["H2"] * math.cos(a - 1.5 * math.pi))
+            np.testing.assert_allclose(out.horizontal, expected, rtol=1e-12, atol=1e-12)
+        return
+    assert isinstance(err, ShipblockError), f"{type(err).__name__}: {err}"
+    if not bad:
+        assert isinstance(err, RecordError) or (sensor is not None
+                                                and first_name(err) == "sensor"), str(err)
+    elif isinstance(err, RecordError):  # a path that names no file: the message names it
+        assert "paths_or_stream" in bad and "paths_or_stream" in str(err), str(err)
+    else:
+        assert first_name(err) in bad, f"{err} (wrong arguments: {sorted(bad)})"
+
+
+@READER_SETTINGS
+@pytest.mark.filterwarnings("ignore")
+@given(path=mostly(st.sampled_from(HELENA + [str(DATA / "two_column_gal.csv")]),
+                   st.sampled_from([None, "", "no_such.AT2", str(DATA), 3.0, b"x.AT2",
+                                    Path("no_such.AT2")]), 4),
+       fmt=option([None, None, "SHIPBLOCK_AT2", "SHIPBLOCK_TEXT", "sac"], ["AT2", "", "XYZ"]),
+       units=st.one_of(st.none(), st.none(), WORDS, GARBAGE),
+       dt=mostly(st.none() | st.sampled_from([0.005, 0.01]), st.one_of(EXTREMES, GARBAGE), 3),
+       resample_rate=mostly(st.none() | st.floats(1.0, 1e4), st.one_of(EXTREMES, GARBAGE), 4))
+def test_read_record_reads_or_names_the_argument(path, fmt, units, dt, resample_rate):
+    """read_record with arguments drawn good or bad: a Stream of finite samples, a record
+    error when the arguments are good but do not suit the file, or an error naming the wrong
+    argument."""
+    out, err = run(lambda: read_record(path, format=fmt, units=units, dt=dt,
+                                       resample_rate=resample_rate))
+    bad = set()
+    if not (isinstance(path, str) and os.path.isfile(path)):
+        bad.add("path")
+    if fmt is not None and not (isinstance(fmt, str) and fmt.upper() in
+                                ("SHIPBLOCK_AT2", "SHIPBLOCK_TEXT", "SAC")):
+        bad.add("format")
+    if units is not None and not a_unit(units):
+        bad.add("units")
+    if dt is not None and not good_real(dt, MIN_TIME_STEP * (1 - 1e-9),
+                                        MAX_TIME_STEP * (1 + 1e-9)):
+        bad.add("dt")
+    if resample_rate is not None and not good_real(resample_rate, 1.0, 1e4):
+        bad.add("resample_rate")
+    if err is None:
+        assert not bad, f"accepted {sorted(bad)}"
+        assert all(np.isfinite(tr.data).all() for tr in out)
+        return
+    assert isinstance(err, ShipblockError), f"{type(err).__name__}: {err}"
+    if not bad:
+        assert isinstance(err, RecordError), f"all arguments good, yet {err}"
+    elif isinstance(err, RecordError):
+        assert "path" in bad and "path must name a record file" in str(err), str(err)
+    else:
+        assert first_name(err) in bad, f"{err} (wrong arguments: {sorted(bad)})"
+
+
+ARRAY = mostly(
+    st.lists(st.floats(-3.0, 3.0), min_size=2, max_size=30).map(np.array),
+    st.one_of(st.lists(SAMPLE, min_size=0, max_size=30).map(np.array),
+              st.lists(st.floats(-5.0, 5.0), min_size=2, max_size=6).map(lambda x: [x, x]),
+              GARBAGE), 3)
+
+
+@READER_SETTINGS
+@given(horizontal=ARRAY, vertical=st.none() | ARRAY, dt=DT,
+       units=mostly(st.sampled_from(["m/s^2", "g", "gal", "cm/s^2", "mg"]),
+                    st.one_of(WORDS, GARBAGE), 4),
+       name=mostly(st.sampled_from(["synthetic", "x"]), st.sampled_from(["", " ", None, 5]), 6),
+       azimuth_h1=AZIMUTH)
+def test_from_arrays_builds_a_plausible_motion_or_names_the_argument(horizontal, vertical, dt,
+                                                                     units, name, azimuth_h1):
+    """GroundMotion.from_arrays: the samples in m/s^2 (the unit factor applied exactly), or a
+    ParameterError naming a wrong argument."""
+    out, err = run(lambda: GroundMotion.from_arrays(horizontal, vertical, dt=dt, units=units,
+                                                    name=name, azimuth_h1=azimuth_h1))
+    factor = (ACCELERATION_UNITS_TO_SI[canonical_unit(units)]
+              if a_unit(units, velocity=False) else None)
+
+    def good_array(x):
+        if factor is None or not good_samples(x, 2):
+            return False
+        with np.errstate(all="ignore"):
+            return bool(np.all(np.abs(np.asarray(x, float) * factor) <= MAX_ACCELERATION))
+
+    bad = set()
+    if factor is None:
+        bad.add("units")
+    elif not good_array(horizontal):
+        bad.add("horizontal")
+    if vertical is not None and factor is not None and not (
+            good_array(vertical) and np.size(vertical) == np.size(horizontal)):
+        bad.add("vertical")
+    if not good_real(dt, MIN_TIME_STEP * (1 - 1e-9), MAX_TIME_STEP * (1 + 1e-9)):
+        bad.add("dt")
+    if not (isinstance(name, str) and name.strip()):
+        bad.add("name")
+    if azimuth_h1 is not None and not an_azimuth(azimuth_h1):
+        bad.add("azimuth_h1")
+    if err is None:
+        assert not bad, f"accepted {sorted(bad)}"
+        np.testing.assert_array_equal(out.horizontal, np.asarray(horizontal, float) * factor)
+        if vertical is not None:
+            np.testing.assert_array_equal(out.vertical, np.asarray(vertical, float) * factor)
+        assert out.dt == pytest.approx(float(dt), rel=1e-14)  # obspy keeps 1 / (1 / dt)
+        return
+    assert isinstance(err, ParameterError), f"{type(err).__name__}: {err}"
+    assert first_name(err) in bad, f"{err} (wrong arguments: {sorted(bad)})"
+
+
+@READER_SETTINGS
+@given(h1=ARRAY, h2=ARRAY, azimuth_h1=ANGLE,
+       turn=st.sampled_from([90.0, -90.0, 270.0, -270.0, 90.0, -90.0, 45.0]), azimuth=ANGLE)
+def test_rotate_to_azimuth_projects_or_names_the_argument(h1, h2, azimuth_h1, turn, azimuth):
+    """rotate_to_azimuth: the projection a1 cos(t - a_1) + a2 cos(t - a_2), which keeps the
+    horizontal vector's length when the target turns by 90 deg; or an error naming a wrong
+    argument."""
+    azimuth_h2 = (float(azimuth_h1) + turn if an_azimuth(azimuth_h1)
+                  and abs(float(azimuth_h1) + turn) <= 360.0 else azimuth_h1)
+    out, err = run(lambda: rotate_to_azimuth(h1, h2, azimuth_h1, azimuth_h2, azimuth))
+    bad = {n for n, v in (("h1", h1), ("h2", h2)) if not (
+        good_samples(v, 1) and bool(np.all(np.abs(np.asarray(v, float)) <= MAX_ACCELERATION)))}
+    if not bad and np.size(h1) != np.size(h2):
+        bad.add("h2")
+    for n, v in (("azimuth_h1", azimuth_h1), ("azimuth_h2", azimuth_h2), ("azimuth", azimuth)):
+        if not an_azimuth(v):
+            bad.add(n)
+    if not {"azimuth_h1", "azimuth_h2"} & bad and (turn == 45.0 or azimuth_h2 == azimuth_h1):
+        bad.add("azimuth_h2")
+    if err is None:
+        assert not bad, f"accepted {sorted(bad)}"
+        other = rotate_to_azimuth(h1, h2, azimuth_h1, azimuth_h2, float(azimuth) + 90.0
+                                  if float(azimuth) <= 270.0 else float(azimuth) - 90.0)
+        h1_, h2_ = np.asarray(h1, float), np.asarray(h2, float)
+        np.testing.assert_allclose(out**2 + other**2, h1_**2 + h2_**2, rtol=1e-9, atol=1e-12)
+        return
+    assert isinstance(err, ParameterError), f"{type(err).__name__}: {err}"
+    assert first_name(err) in bad, f"{err} (wrong arguments: {sorted(bad)})"
+
+
+TOML_VALUE = st.one_of(st.sampled_from(['"g"', '"furlongs"', '"cm/s"', "5", "[]", '""',
+                                        '["a.AT2"]', '{ a = 1 }', "true", "nan"]))
+
+
+@settings(max_examples=40, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow])
+@given(key=st.sampled_from(["units", "files", "components", "station", "id", "inventory"]),
+       value=TOML_VALUE)
+def test_load_catalogue_accepts_or_names_the_record_and_key(key, value):
+    """A catalogue with one value replaced loads, or fails with a RecordError that names the
+    catalogue file and the record's key, never with another exception."""
+    with tempfile.TemporaryDirectory() as folder:
+        shutil.copy(HELENA[0], folder)
+        table = {"id": '"syn/H"', "files": '["helena_synthetic_180.AT2"]', "station": '"H"',
+                 "units": '"g"', key: value}
+        components = table.pop("components", None)
+        lines = ["[[record]]"] + [f"{k} = {v}" for k, v in table.items()]
+        if components is not None:
+            lines.append(f"components = {components}")
+        path = Path(folder) / "catalogue.toml"
+        path.write_text("\n".join(lines) + "\n")
+        out, err = run(lambda: load_catalogue(path))
+        if err is None:
+            (entry,) = out.values()
+            assert entry.units is None or a_unit(entry.units)
+            assert all(p.is_file() for p in entry.files)
+            assert set(entry.components.values()) <= {"H1", "H2", "V"}
+            return
+        assert isinstance(err, RecordError), f"{type(err).__name__}: {err}"
+        assert err.source == str(path)
+        assert key.rstrip("s") in str(err) and "record" in str(err), str(err)

@@ -17,7 +17,7 @@ import obspy
 import pytest
 from obspy import Stream, Trace, UTCDateTime
 
-from shipblock.errors import RecordError, UnitsError
+from shipblock.errors import ParameterError, RecordError, UnitsError
 from shipblock.motion import COMPONENT_KEY, GroundMotion, read_motion, rotate_to_azimuth
 
 DATA = Path(__file__).parent / "data"
@@ -205,12 +205,13 @@ def test_from_arrays_and_with_stream():
     np.testing.assert_allclose(gm2.horizontal, 2 * gm.horizontal)
     assert gm2.metadata["processing"] == ["scaled x2"] and gm.metadata["processing"] == []
     assert GroundMotion.from_arrays([1.0, 2.0], dt=0.01).vertical is None
-    with pytest.raises(RecordError, match="differ in length"):
-        GroundMotion.from_arrays([1.0, 2.0], [1.0], dt=0.01)
-    with pytest.raises(RecordError, match="NaN/inf"):
+    with pytest.raises(ParameterError, match="vertical must have as many samples as"
+                                             " horizontal .2., got 3"):
+        GroundMotion.from_arrays([1.0, 2.0], [1.0, 2.0, 3.0], dt=0.01)
+    with pytest.raises(ParameterError, match="horizontal has 1 sample.*nan at index 1"):
         GroundMotion.from_arrays([1.0, np.nan], dt=0.01)
-    with pytest.raises(UnitsError):
-        GroundMotion.from_arrays([1.0], dt=0.01, units="furlongs")
+    with pytest.raises(ParameterError, match="units must be an acceleration unit .*'furlongs'"):
+        GroundMotion.from_arrays([1.0, 2.0], dt=0.01, units="furlongs")
 
 
 def test_different_sampling_rates_refused_unless_resample_asked():

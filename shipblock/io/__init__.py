@@ -29,18 +29,20 @@ K-NET and KiK-net files are read by obspy and renamed the SEED way by
 :class:`~shipblock.errors.RecordError` naming the file, so that a damaged file (a warning of
 libmseed, a MiniSEED record cut short, an implausible interval, start time or sample) is refused
 rather than read, and so that plain text files (which obspy cannot auto-detect, their units being
-unknown) are read with the caller's ``units``.
+unknown) are read with the caller's ``units``. Its arguments are checked before the file is
+opened (:mod:`shipblock.checks`, :func:`check_format`): a wrong one is a
+:class:`~shipblock.errors.ParameterError` that names it.
 """
 
 from __future__ import annotations
 
-import os
 import warnings
 
 import numpy as np
 import obspy
 
-from shipblock.errors import RecordError, ShipblockError
+from shipblock import checks
+from shipblock.errors import ParameterError, ParameterTypeError, RecordError, ShipblockError
 from shipblock.io import at2, bhrc, cosmos, cwb, dmg, esm, geonet, nsmn, renadic, smc, text, unam, usc
 from shipblock.io._common import (
     check_plausible_samples,
@@ -50,7 +52,7 @@ from shipblock.io._common import (
 )
 from shipblock.io.knet import normalise_knet
 
-__all__ = ["FORMATS", "read_record"]
+__all__ = ["FORMATS", "check_format", "known_formats", "read_record"]
 
 #: Words of a reader's warning that mean the file is damaged: libmseed's reports (truncated
 #: records, Steim integrity checks) and truncation notices. A damaged file is refused rather than
@@ -74,6 +76,57 @@ FORMATS = {
     smc.FORMAT: (smc.is_smc, smc.read_smc),
     text.FORMAT: (text.is_text, text.read_text_record),
 }
+
+
+#: Reader keywords of shipblock's own formats that are numbers, and how each is checked:
+#: ``dt`` of a one-column text file [s], the rate [Hz] uneven SMC/USC pairs are interpolated
+#: onto, the interval [s] of a DMG resampling.
+_NUMERIC_KEYWORDS = {
+    "dt": checks.time_step,
+    "resample_interval": checks.time_step,
+    "resample_rate": lambda value, name: checks.real(
+        value, name, low=1.0 / checks.MAX_TIME_STEP, high=1.0 / checks.MIN_TIME_STEP,
+        units="Hz"),
+}
+
+
+def known_formats() -> list[str]:
+    """The waveform format names :func:`obspy.read` knows, with shipblock's own (sorted)."""
+    from obspy.core.util.base import ENTRY_POINTS
+
+    return sorted(set(ENTRY_POINTS.get("waveform", {})) | set(FORMATS))
+
+
+def check_format(value, name: str = "format") -> str | None:
+    """``value`` checked to be ``None`` (detect the format) or a waveform format obspy knows.
+
+    Parameters
+    ----------
+    value : object
+        The argument; case-insensitive (``"mseed"`` is ``"MSEED"``).
+    name : str
+        Its name, for the message.
+
+    Returns
+    -------
+    str or None
+        The format name in upper case.
+
+    Raises
+    ------
+    ParameterTypeError, ParameterError
+        Naming ``name`` and listing the known formats.
+    """
+    if value is None:
+        return None
+    formats = known_formats()
+    listed = "None (detect it) or one of " + ", ".join(formats)
+    if not isinstance(value, str):
+        raise ParameterTypeError(f"{name} must be {listed}, got {type(value).__name__}"
+                                 f" {value!r}")
+    if value.upper() not in formats:
+        raise ParameterError(f"{name} must be {listed}, got {value!r}")
+    return value.upper()
 
 
 def _looks_like_plain_text(path) -> bool:
@@ -147,11 +200,14 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
         The file.
     format : str, optional
         An obspy format name (``"MSEED"``, ``"SAC"``, ``"KNET"``, ``"SHIPBLOCK_AT2"``,
-        ``"SHIPBLOCK_TEXT"``, ...); auto-detected when omitted.
+        ``"SHIPBLOCK_TEXT"``, ...; case-insensitive); auto-detected when omitted.
     units : str, optional
-        Acceleration unit of a plain text file (passed to the ``SHIPBLOCK_TEXT`` reader only).
+        Acceleration unit of a plain text file (passed to the ``SHIPBLOCK_TEXT`` reader only);
+        any unit :func:`shipblock.checks.unit` knows.
     **kwargs
-        Passed to the reader (for example ``dt`` [s] for a one-column text file).
+        Passed to the reader: ``dt`` [s] for a one-column text file, ``resample_rate`` [Hz] for
+        SMC and USC files, ``resample_interval`` [s] for DMG files (each checked: an interval
+        within 1e-4..1 s, a rate within 1..1e4 Hz), or obspy's own keywords.
 
     Returns
     -------
@@ -162,16 +218,26 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
 
     Raises
     ------
+    ParameterError
+        If an argument is of the wrong type or value (also a :class:`TypeError` for a wrong
+        type): a path that is not a ``str`` or :class:`os.PathLike`, a format obspy does not
+        know, an unknown unit, a ``dt``, ``resample_rate`` or ``resample_interval`` out of range.
     RecordError
-        If the file does not exist, its format is unknown, or it is corrupt or truncated: any
-        libmseed diagnostic (a Steim integrity check, a record cut short) or MiniSEED records
-        that do not account for every byte of the file; NaN/inf samples; a sampling interval
-        outside 1e-4..1 s; a start time outside 1900-2200; samples in m/s^2 above 100 g.
+        If the file does not exist or is a folder, its format is unknown, or it is corrupt or
+        truncated: any libmseed diagnostic (a Steim integrity check, a record cut short) or
+        MiniSEED records that do not account for every byte of the file; NaN/inf samples; a
+        sampling interval outside 1e-4..1 s; a start time outside 1900-2200; samples in m/s^2
+        above 100 g.
     """
-    name = os.fspath(path)
-    if not os.path.isfile(name):
-        raise RecordError(name, "no such file")
-    if format is not None and format.upper() == text.FORMAT:
+    name = checks.existing_file(path, "path", "a record file",
+                                "; read_motions() reads a folder of records")
+    format = check_format(format)  # noqa: A001 - obspy's name for it
+    if units is not None:
+        checks.unit(units, "units")
+    for key, check in _NUMERIC_KEYWORDS.items():
+        if kwargs.get(key) is not None:
+            kwargs[key] = check(kwargs[key], key)
+    if format == text.FORMAT:
         kwargs["units"] = units
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
