@@ -44,6 +44,7 @@ __all__ = [
     "choice",
     "existing_file",
     "flag",
+    "ground_motion",
     "is_real",
     "pathname",
     "real",
@@ -417,4 +418,15 @@ def unit(value, name: str, *, velocity: bool = True) -> str:
                                  f"{value!r}")
     if canonical_unit(value) is None and not (velocity and canonical_velocity_unit(value)):
         raise ParameterError(f"{name} must be {known}, got {value!r}")
+    return value
+
+
+def ground_motion(value, name: str = "motion"):
+    """A :class:`shipblock.motion.GroundMotion`, or a ParameterTypeError naming ``name``."""
+    from shipblock.motion import GroundMotion  # lazy: motion imports obspy
+
+    if not isinstance(value, GroundMotion):
+        raise ParameterTypeError(
+            f"{name} must be a shipblock.motion.GroundMotion (from read_motion or "
+            f"GroundMotion.from_arrays), got {type(value).__name__}")
     return value

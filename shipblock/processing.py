@@ -261,6 +261,7 @@ def process_motion(motion, chain: Iterable[Mapping] | None = None):
         them in ``stats.processing``.
     """
     chain = DEFAULT_CHAIN if chain is None else chain
+    checks.ground_motion(motion)
     processed = apply_chain(motion.stream, chain)
     n_old = len(motion.stream[0].stats.get("processing", [])) if len(motion.stream) else 0
     notes = list(processed[0].stats.get("processing", [])[n_old:]) if len(processed) else []

@@ -450,6 +450,7 @@ def scale_motion(motion, **options):
     """
     from shipblock.motion import COMPONENT_KEY  # lazy: motion imports obspy
 
+    checks.ground_motion(motion)
     result = scale_record(motion.horizontal, motion.vertical, motion.dt, **options)
     args = ", ".join(f"{k}={v!r}" for k, v in sorted(options.items()))
     entry = (

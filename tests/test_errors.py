@@ -20,6 +20,7 @@ from shipblock.errors import ParameterError, ParameterTypeError, RecordError, Sh
 from shipblock.fragility.design import AnalysisDesign, IntensityDesign
 from shipblock.fragility.fit import fit_mle
 from shipblock.fragility.limit_states import LimitState
+from shipblock.processing import process_motion
 from shipblock.units import acceleration_to_si, velocity_to_si
 
 ACC = np.sin(np.linspace(0.0, 10.0, 500))
@@ -75,6 +76,8 @@ CASES = {
                                                       [[0, 0, 1.0, 1.0]]), "dts"),
     "batch without dts": (lambda: simulate_batch(ShipBlockSystem.example(), [(ACC, None)],
                                                  cases=[[0, 0, 1.0, 1.0]]), "dts"),
+    "process_motion of an array": (lambda: process_motion(ACC), "motion"),
+    "scale_motion of a tuple": (lambda: scaling.scale_motion((ACC, None), target=1.0), "motion"),
 }
 
 

@@ -5,6 +5,8 @@ Uses the short synthetic records of ``test_batch.make_catalogue`` through real p
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -110,6 +112,21 @@ def test_rerun_keeps_written_histories_and_result(history_run, monkeypatch):
     monkeypatch.setattr(hist_module, "run_case", fail)
     again = run_pipeline(path, progress=False)
     xr.testing.assert_identical(ds.drop_attrs(deep=False), again.drop_attrs(deep=False))
+
+
+def test_rerun_removes_temporary_files_of_a_killed_history_write(history_run):
+    """A run killed while writing a history file leaves ``.<name>.<random>.tmp``; the next run
+    removes it (and only it), as it does for the result file."""
+    tmp, path, ds = history_run
+    written = [Path(tmp) / "out" / f for f in ds["history_file"].values.ravel() if f]
+    target = written[0]
+    stale = target.parent / f".{target.name}.0a1b2c3d.tmp"
+    other = target.parent / f".{target.name}.keep.tmp"  # not our pattern: kept
+    stale.write_bytes(b"half a NetCDF file")
+    other.write_bytes(b"someone else's")
+    run_pipeline(path, progress=False)
+    assert not stale.exists()
+    assert other.exists()
 
 
 def test_history_request_is_not_part_of_the_run_identity(tmp_path):

@@ -106,6 +106,9 @@ def test_to_dict_round_trips():
         ([{"name": "a", "edp": "peak_ship_slip", "threshold": True}], "finite number"),
         ([{"name": "a", "edp": "peak_ship_slip", "threshold": float("nan")}], "finite number"),
         ([{"name": "a", "edp": "peak_ship_slip", "threshold": -0.1}], "negative"),
+        ([{"name": "a", "edp": "peak_ship_slip", "threshold": 1e300}], r"beyond any value.*1000 m"),
+        ([{"name": "a", "edp": "peak_rotation", "threshold": 4.0}], r"beyond any value"),
+        ([{"name": "a", "edp": "peak_corner_load", "threshold": 1e11}], r"at most 1e\+10 N"),
         (
             [{"name": "a", "edp": "peak_ship_slip", "threshold": 0.1, "condition": "less"}],
             "unknown condition 'less'",

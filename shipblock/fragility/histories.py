@@ -35,7 +35,7 @@ import xarray as xr
 
 from shipblock.errors import ShipblockError
 from shipblock.fragility.design import AnalysisDesign
-from shipblock.fragility.store import write_dataset
+from shipblock.fragility.store import remove_stale_temporaries, write_dataset
 from shipblock.units import STANDARD_GRAVITY
 
 __all__ = [
@@ -342,6 +342,7 @@ def write_histories(design: AnalysisDesign, records, cases: Iterable[int], direc
     written: dict[int, Path] = {}
     for case in tqdm(cases, desc="histories", unit="run", disable=not progress or not cases):
         path = directory / history_filename(design, case)
+        remove_stale_temporaries(path)  # left by a run killed while writing this file
         if fingerprint and _same_run(path, fingerprint):
             written[case] = path
             continue

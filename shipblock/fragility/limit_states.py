@@ -88,6 +88,13 @@ class EDPInfo(NamedTuple):
     magnitude: bool = False
 
 
+#: Largest threshold accepted per EDP unit: beyond it no run can exceed the limit state, so the
+#: number is a typo or a unit mistake (a slip of 1 km, a rotation beyond half a turn, a load of a
+#: million tonnes on one block, a ratio or count of a billion).
+_LARGEST_THRESHOLD: Mapping[str, float] = MappingProxyType(
+    {"m": 1e3, "rad": math.pi, "N": 1e10, "1": 1e9})
+
+
 #: Summary variables that limit states may refer to. ``failure_time`` [s] is also part of a run
 #: summary but is not an EDP (it is undefined for runs that did not fail).
 EDP_VARIABLES: Mapping[str, EDPInfo] = MappingProxyType(
@@ -214,6 +221,11 @@ class LimitState:
             raise ParameterError(
                 f"{who}: threshold {t!r} [{info.units}] is negative but {self.edp!r} is compared "
                 "as a non-negative magnitude"
+            )
+        elif t > _LARGEST_THRESHOLD[info.units]:
+            raise ParameterError(
+                f"{who}: threshold {t!r} [{info.units}] is beyond any value {self.edp!r} can take "
+                f"(at most {_LARGEST_THRESHOLD[info.units]:g} {info.units}); a unit mistake?"
             )
         return self
 
