@@ -7,7 +7,6 @@ returns their summaries.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 
 import numba
@@ -43,7 +42,7 @@ SUMMARY_FIELDS = {
     "input_work": K.S_W_IN,
     "friction_dissipation": K.S_DISSIPATED,
     "impact_loss": K.S_IMPACT_LOSS,
-    "n_mode_fallbacks": K.S_N_FALLBACK,
+    "n_jams": K.S_N_JAMS,
     "final_energy": K.S_ENERGY_FINAL,
 }
 MODE_TIME_FIELDS = [f"time_in_mode_{m}" for m in range(1, 9)]
@@ -188,15 +187,6 @@ def simulate(
     )
     events = EventLog(ev_t, ev_k, ev_f, ev_to)
     summ = _summary_dict(summary, system)
-    if summ["n_mode_fallbacks"] > 0:
-        warnings.warn(
-            f"no mode was consistent at {int(summ['n_mode_fallbacks'])} event(s); the least-violating "
-            "candidate was taken. This happens in the Painleve regime of rocking with Coulomb "
-            "friction (mu_k > tan(phi) while the pivot slides against the rocking direction), "
-            "where the rigid-body model has no consistent solution; see docs/theory/transitions.",
-            RuntimeWarning,
-            stacklevel=2,
-        )
     fail = failure_name(summary[K.S_FAILURE])
     return SimulationResult(
         time=time,
@@ -226,6 +216,7 @@ def _summary_dict(summary: np.ndarray, system: ShipBlockSystem) -> dict:
     out["peak_rotation_ratio"] = out["peak_rotation"] / system.critical_angle
     out["uplift"] = bool(out["uplift"])
     out["n_impacts"] = int(out["n_impacts"])
+    out["n_jams"] = int(out["n_jams"])
     out["failure"] = int(out["failure"])
     return out
 
