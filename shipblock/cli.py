@@ -27,7 +27,7 @@ SYSTEM_FLAGS = {
     "mu_s_ship": ("--mu-s-ship", float, "static friction blocks/ship"),
     "mu_k_ship": ("--mu-k-ship", float, "kinetic friction blocks/ship"),
     "restitution": ("--restitution", float, "restitution theta_dot+/theta_dot- (default: system value)"),
-    "impact_rule": ("--impact-rule", str, "impact rule: momentum (default) or paper"),
+    "impact_rule": ("--impact-rule", str, "impact rule: momentum (default), paper or plastic"),
 }
 
 

@@ -108,6 +108,7 @@ class EventKind(IntEnum):
     OVERTURNING = 8  #: ``|theta|`` reached theta_c = atan(B/H): failure
     SEPARATION = 9  #: a normal force reached zero: failure
     SOLVER_ERROR = 10  #: the integrator could not continue (reported, run stopped)
+    JAM = 11  #: a slipping interface jammed: an impulsive friction force stopped its slip
 
 
 class Failure(IntEnum):

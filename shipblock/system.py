@@ -17,7 +17,7 @@ from shipblock.checks import choice, real, whole
 from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.units import STANDARD_GRAVITY
 
-IMPACT_RULES = ("momentum", "paper")
+IMPACT_RULES = ("momentum", "paper", "plastic")
 
 # Positions in the parameter vector handed to the compiled kernels.
 P_M = 0  # ship mass M [kg]
@@ -32,7 +32,7 @@ P_MUK1 = 8  # kinetic friction, blocks on ground [-]
 P_MUS2 = 9  # static friction, ship on blocks [-]
 P_MUK2 = 10  # kinetic friction, ship on blocks [-]
 P_E = 11  # coefficient of restitution theta_dot+/theta_dot- [-]
-P_RULE = 12  # impact rule: 0 momentum-consistent, 1 paper (scale theta_dot only)
+P_RULE = 12  # impact rule: 0 momentum-consistent, 1 paper (scale theta_dot only), 2 plastic
 P_G = 13  # gravity [m/s^2]
 N_PARAMS = 14
 
@@ -124,11 +124,14 @@ class ShipBlockSystem:
     restitution : float or None, optional
         Ratio :math:`\\dot\\theta^+/\\dot\\theta^-` at an impact [-]. ``None`` (default) uses
         :func:`system_restitution`.
-    impact_rule : {"momentum", "paper"}, optional
+    impact_rule : {"momentum", "paper", "plastic"}, optional
         ``"momentum"`` (default) keeps the generalised momenta of the slipping coordinates
         through an impact (impulses at slipping interfaces are frictionless), so an impact
         never creates energy. ``"paper"`` scales :math:`\\dot\\theta` only and keeps the slip
-        velocities (exact only when both interfaces stick).
+        velocities (exact only when both interfaces stick). ``"plastic"`` takes all the
+        velocities after the impact from the momentum balance about the new pivot
+        (generalised Housner; :func:`shipblock.impact.apply_impact`); it fixes the
+        restitution itself, so ``restitution`` must then be None.
     block_inertia : float or None, optional
         Centroidal inertia of one block :math:`I` [kg m^2]; ``None`` gives the uniform block
         :math:`m(B^2+H^2)/3`.
@@ -180,6 +183,10 @@ class ShipBlockSystem:
                     "above static friction is not physical"
                 )
         choice(self.impact_rule, "impact_rule", IMPACT_RULES)
+        if self.impact_rule == "plastic" and self.restitution is not None:
+            raise ParameterError(
+                f"restitution must be None with impact_rule='plastic' (got {self.restitution!r}): "
+                "the plastic projection gives the velocities after an impact itself")
         if self.block_inertia is not None:
             # every point of a block lies within R of its centroid: I <= m R^2; far below
             # MIN_INERTIA_RATIO m R^2 the block is a point mass and the ratio underflows

@@ -352,6 +352,102 @@ def test_sliding_impact_projection_row():
     assert sp.simplify(p_post_coords[2] - Kq[2]) == 0
 
 
+def _plastic_projection(free_b, free_s):
+    """The plastic impact (generalised Housner) from the kinematics: the post-impact momenta
+    p = J+^T M J- qdot- (impulses only at the new pivot and the new ship contact); the rows of
+    the free coordinates (the rotation, and the slips of interfaces that slip: frictionless
+    impulses) keep them, the held slips are zero. Returns (qdot-, qdot+)."""
+    J, Mb = _impact_jacobians()
+    qd = sp.Matrix(sp.symbols("vb om vs", real=True))
+    p = J[-1].T * Mb * J[1] * qd
+    K0 = J[-1].T * Mb * J[-1]
+    free = [0] * free_b + [1] + [2] * free_s
+    q_plus = sp.zeros(3, 1)
+    sol = K0.extract(free, free).LUsolve(p.extract(free, [0]))
+    for k, i in enumerate(free):
+        q_plus[i] = sol[k]
+    if not free_b:
+        qd[0] = 0
+    if not free_s:
+        qd[2] = 0
+    return qd, q_plus.subs({sp.Symbol("vb", real=True): qd[0], sp.Symbol("vs", real=True): qd[2]})
+
+
+def _plastic_restitution(free_b, free_s):
+    """e_F = 1 - 2 (nm + 4M) B^2 / J_eff,F, J_eff,F the rotation's inertia with the momenta of
+    the slipping coordinates held (Schur complement of K(theta = 0))."""
+    K0 = sp.Matrix([[nm + M, -(nm + 2 * M) * H, M],
+                    [-(nm + 2 * M) * H, nI + (nm + 4 * M) * (B**2 + H**2), -2 * M * H],
+                    [M, -2 * M * H, M]])
+    S = [0] * free_b + [2] * free_s
+    j_eff = K0[1, 1]
+    if S:
+        j_eff -= (K0.extract([1], S) * K0.extract(S, S).inv() * K0.extract(S, [1]))[0]
+    return 1 - 2 * (nm + 4 * M) * B**2 / j_eff
+
+
+@pytest.mark.parametrize("free_b,free_s", [(0, 0), (1, 0), (0, 1), (1, 1)],
+                         ids=["stick", "ground-slips", "ship-slips", "both-slip"])
+def test_plastic_impact_rule_is_generalised_housner(free_b, free_s):
+    """impact_rule="plastic": the post-impact velocities from the momentum balance about the
+    new pivot (the momenta of the post-impact coordinates, J+^T M J- qdot-), frictionless
+    impulses at the interfaces that slip. The ratio theta_dot+/theta_dot- is
+    e_F = 1 - 2 (nm + 4M) B^2 / J_eff,F: it depends on *which* interfaces slip, not on how
+    fast (symbolic); with both sticking it is e_sys (notes sec. 5) and, for a single block
+    without ship, Housner's 1 - 3/2 sin^2(alpha); a single block sliding on a frictionless
+    ground gets (I - m B^2)/(I + m B^2). The implementation (shipblock.impact) gives the same
+    velocities and never gains energy."""
+    qd, q_plus = _plastic_projection(free_b, free_s)
+    om = qd[1]
+    e_f = _plastic_restitution(free_b, free_s)
+    assert sp.simplify(q_plus[1] - e_f * om) == 0
+    if not free_b:
+        assert q_plus[0] == 0
+    if not free_s:
+        assert q_plus[2] == 0
+    e_notes = (nI + (nm + 4 * M) * (H**2 - B**2)) / (nI + (nm + 4 * M) * (H**2 + B**2))
+    al = sp.Symbol("alpha", positive=True)
+    uniform = {Ib: m * (B**2 + H**2) / 3}
+    single = sp.limit(e_f.subs(uniform), M, 0)
+    if (free_b, free_s) == (0, 0):
+        assert sp.simplify(e_f - e_notes) == 0
+        housner = single.subs({B: sp.sin(al), H: sp.cos(al)})
+        assert sp.simplify(sp.expand_trig(housner - (1 - sp.Rational(3, 2) * sp.sin(al) ** 2))) == 0
+    if (free_b, free_s) == (1, 0):
+        assert sp.simplify(sp.limit(e_f, M, 0) - (Ib - m * B**2) / (Ib + m * B**2)) == 0
+        # B/H = 0.2: 0.793 on a frictionless ground, against Housner's 0.942
+        assert float(single.subs({B: 0.2, H: 1.0})) == pytest.approx(0.92 / 1.16, rel=1e-12)
+    # the implementation, at random points
+    from shipblock import ShipBlockSystem
+    from shipblock.impact import impact_velocities
+
+    f_plus = sp.lambdify((M, m, n, Ib, B, H, *sp.symbols("vb om vs", real=True)),
+                         list(q_plus), "numpy")
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        Mv, mv, nv = rng.uniform(10, 5e3), rng.uniform(10, 2e3), int(rng.integers(1, 9))
+        Bv, Hv = rng.uniform(0.1, 0.5), rng.uniform(0.5, 1.5)
+        Iv = mv * (Bv**2 + Hv**2) * rng.uniform(0.2, 0.45)
+        system = ShipBlockSystem(ship_mass=Mv, block_mass=mv, n_blocks=nv, half_width=Bv,
+                                 half_height=Hv, mu_s_ground=0.5, mu_k_ground=0.4,
+                                 mu_s_ship=0.5, mu_k_ship=0.4, block_inertia=Iv,
+                                 impact_rule="plastic")
+        vb = rng.uniform(-1, 1) if free_b else 0.0
+        vs = rng.uniform(-1, 1) if free_s else 0.0
+        w = rng.choice([-1.0, 1.0]) * rng.uniform(0.1, 2.0)
+        vb2, w2, vs2, loss = impact_velocities(system, w, vb, vs)
+        want = f_plus(Mv, mv, nv, Iv, Bv, Hv, vb, w, vs)
+        e_num = float(e_f.subs({M: Mv, m: mv, n: nv, Ib: Iv, B: Bv, H: Hv}))
+        if e_num <= 0:  # no rotation onto the new pivot: the rocking stops (theta_dot = 0)
+            assert w2 == 0.0
+            continue
+        np.testing.assert_allclose([vb2, w2, vs2], want, rtol=1e-11, atol=1e-13)
+        assert loss >= 0.0
+        # the momentum rule at the same impact: e_sys theta_dot, the slip momenta kept
+        _, w_mom, _, _ = impact_velocities(system.replace(impact_rule="momentum"), w, vb, vs)
+        assert w2 / w_mom == pytest.approx(e_num / system.effective_restitution, rel=1e-11)
+
+
 # ------------------------------------------------------------------------------------------
 # 5. the paper's printed equations, one by one
 # ------------------------------------------------------------------------------------------

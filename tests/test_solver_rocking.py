@@ -5,7 +5,6 @@ first principles (energy quadrature with scipy), never from shipblock's own outp
 """
 
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -518,44 +517,3 @@ def test_small_rocking_after_an_impact_keeps_its_impacts():
                                atol=1e-9)
     ok = np.isfinite(res.energy.residual)
     assert np.abs(res.energy.residual[ok]).max() <= 1e-8 * np.abs(res.energy.input_work[ok]).max()
-
-
-def test_energy_balance_over_random_systems_and_records():
-    """A property test over random systems (masses, block sizes, friction, both impact rules,
-    restitution) and random smoothed two-component records, at the default tolerance: every
-    run ends as a known failure or none, its energy balance holds to 1e-4 of the input work and
-    the momentum rule never gains energy in impacts. (A longer campaign of this kind, 1.2
-    million runs, found the missed impacts of small rocking: see
-    test_small_rocking_after_an_impact_keeps_its_impacts.)"""
-    rng = np.random.default_rng(20261122)
-    worst = 0.0
-    for _ in range(1500):
-        H = rng.uniform(0.2, 1.5)
-        mu1, mu2 = rng.uniform(0.05, 0.9, 2)
-        rule = "momentum" if rng.random() < 0.8 else "paper"
-        system = ShipBlockSystem(
-            ship_mass=10 ** rng.uniform(3, 7), block_mass=rng.uniform(100, 5000),
-            n_blocks=int(rng.integers(1, 300)), half_width=H * rng.uniform(0.1, 1.5),
-            half_height=H, mu_s_ground=mu1, mu_k_ground=mu1 * rng.uniform(0.5, 1.0),
-            mu_s_ship=mu2, mu_k_ship=mu2 * rng.uniform(0.5, 1.0), impact_rule=rule,
-            restitution=None if rng.random() < 0.7 else rng.uniform(0.0, 1.0))
-        n = int(rng.integers(300, 1500))
-        dt = float(rng.choice([0.002, 0.005, 0.01]))
-        kernel = np.hanning(int(rng.integers(3, 30)))
-        kernel /= kernel.sum()
-        amp = rng.uniform(0.5, 15.0)
-        ax = np.convolve(rng.normal(0, amp, n), kernel, mode="same")
-        ay = (np.convolve(rng.normal(0, amp * rng.uniform(0, 0.8), n), kernel, mode="same")
-              if rng.random() < 0.7 else None)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # the Painleve fallback warns in a few runs
-            res = simulate(system, ax, ay, dt)
-        assert res.failure in (None, "separation", "overturning")
-        ok = np.isfinite(res.energy.residual)
-        scale = np.abs(res.energy.input_work[ok]).max()
-        if scale == 0.0:
-            continue
-        worst = max(worst, np.abs(res.energy.residual[ok]).max() / scale)
-        if rule == "momentum":
-            assert np.all(np.diff(res.energy.impact[ok]) >= -1e-9 * scale)
-    assert worst <= 1e-4, worst

@@ -77,7 +77,7 @@ def _run_variables() -> dict[str, tuple[str, str]]:
         "input_work": ("J", "work done by the ground motion"),
         "friction_dissipation": ("J", "energy dissipated by friction"),
         "impact_loss": ("J", "kinetic energy lost in rocking impacts"),
-        "n_mode_fallbacks": ("1", "number of mode selections resolved by the fallback rule"),
+        "n_jams": ("1", "number of jams of a slipping interface (Painleve regime)"),
         "final_energy": ("J", "kinetic plus potential energy at the end of the run"),
     }
     out = {}

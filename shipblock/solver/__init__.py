@@ -7,7 +7,6 @@ returns their summaries.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 
 import numba
@@ -50,7 +49,7 @@ SUMMARY_FIELDS = {
     "input_work": K.S_W_IN,
     "friction_dissipation": K.S_DISSIPATED,
     "impact_loss": K.S_IMPACT_LOSS,
-    "n_mode_fallbacks": K.S_N_FALLBACK,
+    "n_jams": K.S_N_JAMS,
     "final_energy": K.S_ENERGY_FINAL,
     "peak_ground_normal_force": K.S_PEAK_FY,
     "peak_ground_friction_force": K.S_PEAK_FX,
@@ -218,15 +217,6 @@ def simulate(
     )
     events = EventLog(ev_t, ev_k, ev_f, ev_to)
     summ = _summary_dict(summary, system)
-    if summ["n_mode_fallbacks"] > 0:
-        warnings.warn(
-            f"no mode was consistent at {int(summ['n_mode_fallbacks'])} event(s); the least-violating "
-            "candidate was taken. This happens in the Painleve regime of rocking with Coulomb "
-            "friction (mu_k > tan(phi) while the pivot slides against the rocking direction), "
-            "where the rigid-body model has no consistent solution; see docs/theory/transitions.",
-            RuntimeWarning,
-            stacklevel=2,
-        )
     fail = failure_name(summary[K.S_FAILURE])
     return SimulationResult(
         time=time,
@@ -258,6 +248,7 @@ def _summary_dict(summary: np.ndarray, system: ShipBlockSystem) -> dict:
         out[name] /= system.n_blocks
     out["uplift"] = bool(out["uplift"])
     out["n_impacts"] = int(out["n_impacts"])
+    out["n_jams"] = int(out["n_jams"])
     out["failure"] = int(out["failure"])
     return out
 

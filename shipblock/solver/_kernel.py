@@ -38,7 +38,7 @@ from shipblock.equations import (
     stuck_rocking_gain,
     stuck_rocking_rates,
 )
-from shipblock.impact import apply_impact
+from shipblock.impact import apply_impact, apply_jam
 from shipblock.modes import MODE_NUMBER, EventKind, Failure
 from shipblock.solver._closed_form import mode_response_start, nonrocking_span
 from shipblock.solver._dopri import DP_A, DP_C, DP_E, DP_ERROR_ORDER
@@ -84,6 +84,7 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     N_STATE,
     N_SUMMARY,
     ONE_SIDED_DT,
+    ONE_SIDED_WIDE,
     REARM_TOL,
     ROOT_TIME_TOL,
     S_DISSIPATED,
@@ -94,8 +95,8 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     S_IMPACT_LOSS,
     S_MODE_TIME,
     S_N_EVENTS,
-    S_N_FALLBACK,
     S_N_IMPACTS,
+    S_N_JAMS,
     S_PEAK_CORNER,
     S_PEAK_FX,
     S_PEAK_FY,
@@ -450,7 +451,10 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
     holds, new motions accelerate in their assumed direction and both normal forces are positive.
     Among consistent candidates the one with the fewest new motions wins; ties go to the one
     releasing ``trigger`` (0 ground, 1 rocking, 2 ship), then to the lower paper mode number.
-    If none is consistent, the one with the least total violation is taken.
+    If none is consistent, the system separates when every candidate has a non-positive normal
+    force or when the ship leaving the blocks is consistent (:func:`ship_lifts_off`);
+    otherwise the state is in the Painleve regime and the caller jams a slipping interface
+    (:func:`resolve_mode`).
 
     The candidates are visited in that order of preference (by number of new motions, then
     trigger, then mode number; tabulated in ``CANDIDATE_KEYS``), so the first consistent one is
@@ -487,8 +491,8 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
     Returns
     -------
     status : int
-        0 a consistent mode was chosen, 1 none was consistent and the least-violating was
-        taken, 2 every candidate had a non-positive normal force (separation).
+        0 a consistent mode was chosen (into ``ms``), 1 none was consistent (``ms`` is then
+        left undefined), 2 separation.
     """
     G = p[P_G] + b
     if G <= 0.0:
@@ -497,17 +501,11 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
     ship_weight = p[P_M] * p[P_G]
     vb, th, om, vs = y[Y_VB], y[Y_TH], y[Y_OM], y[Y_VS]
     rot = th if th != 0.0 else om
-    best_viol = 1e300
-    best_key2 = 2
-    best_mode = 99
-    best0 = best1 = best2 = best3 = best4 = best5 = 0
     all_separate = True
     case = (4 if vb != 0.0 else 0) + (2 if rot != 0.0 else 0) + (1 if vs != 0.0 else 0)
     order = CANDIDATE_KEYS[case, trigger + 1]
     for jc in range(CANDIDATE_COUNTS[case, trigger + 1]):
         idx = order[jc] % 32
-        key2 = order[jc] // 512
-        mode = (order[jc] // 32) % 16
         slip1, sig1, new1, rock, s, newr, slip2, sig2, new2 = candidate_options(idx, vb, rot, vs)
         if rock == 0:
             # a non-rocking candidate exists only at theta = theta_dot = 0 (candidate_options),
@@ -548,16 +546,168 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
             # the most preferred consistent candidate: the choice
             ms[0], ms[1], ms[2], ms[3], ms[4], ms[5] = slip1, rock, slip2, s, sig1, sig2
             return 0
-        if viol < best_viol or (viol == best_viol and (
-                key2 < best_key2 or key2 == best_key2 and mode < best_mode)):
-            best_viol, best_key2, best_mode = viol, key2, mode
-            best0, best1, best2 = slip1, rock, slip2
-            best3, best4, best5 = s, sig1, sig2
-    if all_separate:
+    if all_separate or ship_lifts_off(p, y, a, G, w7) or blocks_lift_off(p, y, a, G, w7):
         return 2
-    ms[0], ms[1], ms[2], ms[3], ms[4], ms[5] = best0, best1, best2, best3, best4, best5
     return 1
 
+
+@njit(cache=True, _nrt=False)
+def blocks_lift_off(p, y, a, G, w7):
+    """Whether the blocks leaving the ground is a consistent continuation at state ``y``.
+
+    Only rocking blocks can (without rocking, :math:`f_y > 0` while :math:`G > 0`): their
+    corner lifts when the centripetal terms outweigh what presses it, in practice when the
+    ground falls at nearly :math:`g`. With the ground's friction removed, the pivot's
+    effective inertia is positive, so a negative :math:`f_y` of that frictionless contact and
+    a consistent lift-off go together (the lift-off does not depend on the ground's friction,
+    which it releases). The ship is taken as it is: stuck, or sliding without friction.
+    """
+    th, om, vs = y[Y_TH], y[Y_OM], y[Y_VS]
+    rot = th if th != 0.0 else om
+    # frictionless ground (and ship, if it slides)
+    pf = (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], 0.0, p[9], 0.0, p[11], p[12], p[13])
+    slip2 = 1 if vs != 0.0 else 0
+    for ir in range(3):
+        rock, s, _ = interface_option(rot, ir)
+        if rock != 1:
+            continue
+        c, sn = pivot_geometry(pf, th, float(s), 1)
+        if (solve_mode_at(pf, 1, 1, slip2, float(s), 1.0, 1.0, c, sn, om, a, G, w7)
+                and w7[I_FY] < -FORCE_TOL * (p[P_NM] + p[P_M]) * p[P_G]):
+            return True
+    return False
+
+
+@njit(cache=True, _nrt=False)
+def ship_lifts_off(p, y, a, G, w7):
+    """Whether the ship leaving the blocks is a consistent continuation at state ``y``.
+
+    For each candidate motion of the blocks that rocks (a corner carrying the ship can only
+    drop away from it while the blocks rock), the blocks are solved without the ship; the
+    continuation is consistent when that motion is (ground force inside its static cone or a
+    new slip accelerating in its direction, new rocking accelerating in its direction,
+    :math:`f_y > 0`) and the ship's contact corner then accelerates downwards faster than the
+    ship falls, :math:`-G - 2Y' > 0` relative to the ground. Called when no mode with contact
+    is consistent: with a regular (positive) effective inertia of the ship's contact, a
+    negative contact force there and a consistent lift-off go together, and the ship
+    separates (:doc:`/theory/transitions`).
+
+    ``p`` is the parameter array, ``a`` and ``G`` the ground input (``G = g + ay``) [m/s^2],
+    ``w7`` a work array.
+    """
+    g = p[P_G]
+    R = p[P_R]
+    th, om, vb = y[Y_TH], y[Y_OM], y[Y_VB]
+    rot = th if th != 0.0 else om
+    # the blocks alone: the parameters with no ship
+    pf = (0.0, p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11], p[12],
+          p[13])
+    block_weight = p[P_NM] * g
+    for ir in range(3):
+        rock, s, newr = interface_option(rot, ir)
+        if rock != 1:
+            continue
+        c, sn = pivot_geometry(pf, th, float(s), 1)
+        for ig in range(3):
+            slip1, sig1, new1 = interface_option(vb, ig)
+            if slip1 < 0:
+                continue
+            if not solve_mode_at(pf, slip1, 1, 0, float(s), float(sig1), 1.0, c, sn, om, a, G,
+                                 w7):
+                continue
+            fx, fy = w7[I_FX], w7[I_FY]
+            if fy <= 0.0:
+                continue
+            if slip1 == 0 and abs(fx) - p[P_MUS1] * fy > FORCE_TOL * block_weight:
+                continue
+            if new1 and sig1 * w7[0] <= ACC_TOL * g:
+                continue
+            if newr and s * w7[1] * R <= ACC_TOL * g:
+                continue
+            corner_yacc = 2.0 * R * (s * sn * w7[1] - c * om * om)
+            if -G - corner_yacc > ACC_TOL * g:
+                return True
+    return False
+
+
+@njit(cache=True, _nrt=False)
+def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K):
+    """:func:`select_mode`, with a jam of a slipping interface when no mode is consistent.
+
+    When the selection finds no consistent mode and no separation, the state is in the
+    Painleve regime: a slipping interface's friction makes the effective inertia of the
+    rocking negative. The interface jams (:func:`shipblock.impact.apply_jam`: an impulsive
+    friction force stops its slip, the rotation keeps its generalised momentum) and the mode
+    is selected again from the velocities after the jam. Trials: each slipping interface alone
+    (the one slipping against the rocking direction first, the ground first otherwise), then
+    both. The first trial whose impulses are admissible (pressing, inside the friction cones)
+    and after which a mode is consistent is taken; failing that, the first admissible one
+    after which the system separates; failing that, the first after which a mode is
+    consistent (impulses beyond a friction cone: not met in random testing).
+
+    Before any of this, a selection with none consistent is repeated with the ground input
+    ``(a_wide, b_wide)`` a little later (``ONE_SIDED_WIDE``): where a constraint is crossed at
+    a slow rate, its violation ``ONE_SIDED_DT`` after the event can exceed ``FORCE_TOL`` while
+    the new motion's push is still below ``ACC_TOL`` (the two tolerances are in different
+    units), and neither the held nor the released state passes.
+
+    Returns
+    -------
+    status : int
+        0 a consistent mode (in ``ms``), 2 separation, 1 no trial helped (the velocities are
+        then those before the jam).
+    loss : float
+        Kinetic energy lost in the jam [J] (0 without one).
+    jammed : int
+        0 no jam, 1 the ground interface, 2 the ship interface, 3 both.
+    jam_from : int
+        Mode number of the motions at the event (the interfaces moving before a jam).
+    """
+    status = select_mode(p, y, ms, a, b, trigger, w7, work)
+    if status == 1 and select_mode(p, y, ms, a_wide, b_wide, trigger, w7, work) == 0:
+        return 0, 0.0, 0, mode_number(ms)
+    vb, om, vs = y[Y_VB], y[Y_OM], y[Y_VS]
+    rot = y[Y_TH] if y[Y_TH] != 0.0 else om
+    jam_from = mode_number_of(1 if vb != 0.0 else 0, 1 if rot != 0.0 else 0,
+                              1 if vs != 0.0 else 0)
+    if status != 1 or (vb == 0.0 and vs == 0.0):
+        return status, 0.0, 0, jam_from
+    first = 1 if vb != 0.0 else 2
+    if vb != 0.0 and vs != 0.0 and rot * vs < 0.0 <= rot * vb:
+        first = 2  # the ship slips against the rocking direction, the ground does not
+    sep_jam = 0
+    any_jam = 0
+    for trial in range(3):
+        jam = first if trial == 0 else (3 - first if trial == 1 else 3)
+        if (jam & 1 and vb == 0.0) or (jam & 2 and vs == 0.0):
+            continue
+        y[Y_VB], y[Y_OM], y[Y_VS] = vb, om, vs
+        loss, admissible = apply_jam(p, jam & 1 != 0, jam & 2 != 0, y, K)
+        status = select_mode(p, y, ms, a, b, trigger, w7, work)
+        if status == 0 and admissible:
+            return 0, loss, jam, jam_from
+        if status == 2 and admissible and sep_jam == 0:
+            sep_jam = jam
+        if status == 0 and any_jam == 0:
+            any_jam = jam
+    jam = sep_jam if sep_jam != 0 else any_jam
+    y[Y_VB], y[Y_OM], y[Y_VS] = vb, om, vs
+    if jam == 0:
+        return 1, 0.0, 0, jam_from
+    loss, _ = apply_jam(p, jam & 1 != 0, jam & 2 != 0, y, K)
+    status = select_mode(p, y, ms, a, b, trigger, w7, work)
+    return status, loss, jam, jam_from
+
+
+@njit(cache=True, inline="always")
+def log_event(ev_t, ev_kft, log_size, n_ev, t, kind, from_mode, to_mode):
+    """Write event ``n_ev`` (time, kind, modes before and after) if the log has room: n_ev + 1."""
+    if n_ev < log_size:
+        ev_t[n_ev] = t
+        ev_kft[0, n_ev] = kind
+        ev_kft[1, n_ev] = from_mode
+        ev_kft[2, n_ev] = to_mode
+    return n_ev + 1
 
 
 @njit(cache=True)
@@ -659,7 +809,7 @@ summary, y_init
     failure = 0
     failure_time = np.nan
     n_impacts = 0
-    n_fallback = 0
+    n_jams = 0
     uplift = 0
     peak_xb = 0.0
     peak_th = 0.0
@@ -671,25 +821,47 @@ summary, y_init
     k = 0
     tau = 0.0
     a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, 0, ONE_SIDED_DT, dt)
-    status = select_mode(p_vec, y, ms, a_next, b_next, -1, w7, span_work)
+    a_wide, b_wide = ground_motion_at(ax, ay, has_ay, sh, sv, 0, ONE_SIDED_WIDE, dt)
+    status, jam_loss, jammed, jam_from = resolve_mode(p_vec, y, ms, a_next, b_next, a_wide,
+                                                      b_wide, -1, w7, span_work, K)
     if status == 2:
         failure = Failure.SEPARATION
         failure_time = 0.0
     elif status == 1:
-        n_fallback += 1
-    if log_size > 0:
-        ev_t[0] = 0.0
-        ev_kft[0, 0] = EventKind.SEPARATION if failure else EventKind.START
-        ev_kft[1, 0] = 0
-        ev_kft[2, 0] = 0 if failure else mode_number(ms)
-    n_ev = 1
+        failure = Failure.SOLVER_ERROR  # no consistent mode and nothing to jam
+        failure_time = 0.0
+    kind = EventKind.START
+    if status == 2:
+        kind = EventKind.SEPARATION
+    elif status == 1:
+        kind = EventKind.SOLVER_ERROR
+    if jammed:
+        n_jams += 1
+        impact_loss += jam_loss
+        y[Y_IMP] += jam_loss
+        n_ev = log_event(ev_t, ev_kft, log_size, n_ev, 0.0, EventKind.START, 0, jam_from)
+        n_ev = log_event(ev_t, ev_kft, log_size, n_ev, 0.0, EventKind.JAM, jam_from,
+                         jam_from if failure else mode_number(ms))
+        if failure:
+            n_ev = log_event(ev_t, ev_kft, log_size, n_ev, 0.0, kind, jam_from, 0)
+    else:
+        n_ev = log_event(ev_t, ev_kft, log_size, n_ev, 0.0, kind, 0,
+                         0 if failure else mode_number(ms))
     if ms[MS_ROCK]:
         uplift = 1
     event_values(p, ms, y, 0, 0.0, dt, ax, ay, has_ay, sh, sv, g0, w7)
     if failure == 0:
         note_loads(p, ms[MS_ROCK], w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY], summary)
     if store:
-        store_sample(p, ms, y, hist, modes, 0, 0 if failure else mode_number(ms))
+        if jammed:
+            # sample 0 holds the initial state as given (the jam at t = 0 shows from sample 1 on),
+            # so that the energy balance of the histories starts from it
+            vb_jam, om_jam, vs_jam = y[Y_VB], y[Y_OM], y[Y_VS]
+            y[Y_VB], y[Y_OM], y[Y_VS], y[Y_IMP] = y_init[3], y_init[4], y_init[5], 0.0
+            store_sample(p, ms, y, hist, modes, 0, 0 if failure else mode_number(ms))
+            y[Y_VB], y[Y_OM], y[Y_VS], y[Y_IMP] = vb_jam, om_jam, vs_jam, jam_loss
+        else:
+            store_sample(p, ms, y, hist, modes, 0, 0 if failure else mode_number(ms))
     h_rock = dt
     events_here = 0
     g0_stale = False
@@ -862,6 +1034,7 @@ summary, y_init
             state_loads(p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary)
             trigger = -1
             kind = EventKind.START
+            jammed = 0
             if best_e == EV_G_SLIP:
                 y[Y_VB] = 0.0
                 trigger = 0
@@ -894,20 +1067,33 @@ summary, y_init
             else:
                 failure = Failure.SEPARATION
                 kind = EventKind.SEPARATION
+            trigger_kind = kind
+            jam_from = from_mode
             if failure == 0:
                 old0, old1, old2, old3, old4, old5 = ms[0], ms[1], ms[2], ms[3], ms[4], ms[5]
                 a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + ONE_SIDED_DT,
                                                   dt)
-                status = select_mode(p_vec, y, ms, a_next, b_next, trigger, w7, span_work)
+                a_wide, b_wide = ground_motion_at(ax, ay, has_ay, sh, sv, k,
+                                                  tau + ONE_SIDED_WIDE, dt)
+                status, jam_loss, jammed, jam_from = resolve_mode(
+                    p_vec, y, ms, a_next, b_next, a_wide, b_wide, trigger, w7, span_work, K)
+                if jammed:
+                    # the jam's loss is booked with the impacts' (a tangential impact)
+                    n_jams += 1
+                    impact_loss += jam_loss
+                    y[Y_IMP] += jam_loss
                 if status == 2:
                     failure = Failure.SEPARATION
                     kind = EventKind.SEPARATION
+                elif status == 1:
+                    # no consistent mode, no separation and no slip to jam: not met in random
+                    # testing (docs/theory/transitions.rst); the run stops rather than guess
+                    failure = Failure.SOLVER_ERROR
+                    kind = EventKind.SOLVER_ERROR
                 else:
-                    if status == 1:
-                        n_fallback += 1
                     same = (old0 == ms[0] and old1 == ms[1] and old2 == ms[2]
                             and old3 == ms[3] and old4 == ms[4] and old5 == ms[5])
-                    if same and best_e != EV_IMPACT:
+                    if same and best_e != EV_IMPACT and not jammed:
                         # grazing contact: the constraint touched zero and holds again
                         armed[best_e] = False
                     else:
@@ -918,13 +1104,21 @@ summary, y_init
                     state_loads(p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary)
             if failure != 0:
                 failure_time = t_now
-            if n_ev < log_size:
-                ev_t[n_ev] = t_now
-                ev_kft[0, n_ev] = kind
-                ev_kft[1, n_ev] = from_mode
-                ev_kft[2, n_ev] = 0 if failure else mode_number(ms)
-            n_ev += 1
-            events_here += 1
+            if jammed or kind != trigger_kind:
+                # the event itself, into the motions it leaves; the jam or the failure the mode
+                # selection found follows it
+                n_ev = log_event(ev_t, ev_kft, log_size, n_ev, t_now, trigger_kind, from_mode,
+                                 jam_from)
+                events_here += 1
+                from_mode = jam_from
+            if jammed:
+                n_ev = log_event(ev_t, ev_kft, log_size, n_ev, t_now, EventKind.JAM, jam_from,
+                                 jam_from if failure else mode_number(ms))
+                events_here += 1
+            if not jammed or failure != 0:
+                n_ev = log_event(ev_t, ev_kft, log_size, n_ev, t_now, kind, from_mode,
+                                 0 if failure else mode_number(ms))
+                events_here += 1
             if events_here > MAX_EVENTS_PER_SAMPLE and failure == 0:
                 failure = Failure.SOLVER_ERROR
                 failure_time = t_now
@@ -970,7 +1164,7 @@ summary, y_init
     summary[S_W_IN] = y[Y_WIN]
     summary[S_DISSIPATED] = y[Y_DIS]
     summary[S_IMPACT_LOSS] = impact_loss
-    summary[S_N_FALLBACK] = n_fallback
+    summary[S_N_JAMS] = n_jams
     s_final = float(ms[MS_S]) if ms[MS_ROCK] else 1.0
     summary[S_ENERGY_FINAL] = kinetic_energy(
         p, y[Y_TH], s_final, ms[MS_ROCK], y[Y_VB], y[Y_OM], y[Y_VS]

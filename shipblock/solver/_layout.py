@@ -54,7 +54,7 @@ S_N_EVENTS = 18
 S_W_IN = 19
 S_DISSIPATED = 20
 S_IMPACT_LOSS = 21
-S_N_FALLBACK = 22
+S_N_JAMS = 22  # jams of a slipping interface (Painleve regime)
 S_ENERGY_FINAL = 23  # T + V at the end
 S_PEAK_TH_TIME = 24
 # Peak contact loads (see shipblock.solver._loads): interface forces, totals over the n blocks
@@ -92,6 +92,8 @@ ROOT_TIME_TOL = 1e-12  # [s] width of the bracket that locates an event
 # good guess closes the bracket at once
 GUESS_PROBE = 5e-13
 ONE_SIDED_DT = 1e-8  # [s] candidate modes are checked this long after an event
+# [s] and this long, when none is consistent at ONE_SIDED_DT (a slow crossing, see resolve_mode)
+ONE_SIDED_WIDE = 1e-6
 FORCE_TOL = 1e-10  # [-] tolerance on force margins, relative to the weight
 ACC_TOL = 1e-10  # [-] a new motion must accelerate by more than this times g
 REARM_TOL = 1e-9  # [-] a disarmed event is re-armed once its function exceeds this
