@@ -14,6 +14,18 @@ Nothing here allocates per step; the kernels take only arrays and scalars. :func
 allocates the work arrays: the loop itself (:func:`integrate`), mode selection and the functions
 it calls are compiled without reference counting, like the closed-form span (see
 :mod:`~shipblock.solver._closed_form`).
+
+Compilation. The small functions of the step (``forceinline=True`` throughout the solver's
+modules) are inlined by LLVM, not by numba: numba's own inlining (``inline="always"``) typed
+and copied a function's body again at every call site, in every caller, which took most of the
+two minutes the first run spent compiling. Each is now typed and compiled once and marked
+``alwaysinline``; LLVM inlines it where it is called, so the machine code and the results are
+those of before, bit for bit, at the same speed (docs/benchmarks). The other functions say
+``forceinline=False``: numba hands the flags of a function being compiled down to the callees
+it compiles for it, and a function that should stay out of line must not inherit the flag
+from whichever caller compiled it first. Constants passed to compiled functions are typed
+``np.int64(0)`` or ``np.bool_(True)`` where a plain ``0`` or ``True`` would be a literal:
+numba compiles a function once more for each literal argument.
 """
 
 from __future__ import annotations
@@ -126,7 +138,7 @@ from shipblock.solver._workqueue import claim_next
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def rhs(p, ms, y, a, ay, stages, st, w7):
     """Time derivative of the state in the mode ``ms`` into ``stages[st]``; False if singular."""
     rock = ms[MS_ROCK]
@@ -149,7 +161,7 @@ def rhs(p, ms, y, a, ay, stages, st, w7):
     return ok
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
             first_stage_known, rtol, atol):
     """One Dormand-Prince 5(4) step of ``h`` within sample interval ``k``: its error norm.
@@ -178,7 +190,7 @@ def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, 
     return error_norm(y0, y1, stages, h, rtol, atol)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def advance_general(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
                     first_stage_known):
     """The step of :func:`advance` in any rocking mode, on the whole state: False if singular.
@@ -208,7 +220,7 @@ def advance_general(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def error_norm(y0, y1, stages, h, rtol, atol):
     """RMS of the embedded error estimate scaled by atol + rtol*|y| over the dynamic states."""
     acc = 0.0
@@ -222,7 +234,7 @@ def error_norm(y0, y1, stages, h, rtol, atol):
     return math.sqrt(acc / N_DYN)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g, w7):
     """Fill ``g`` with the event functions at (t_k + tau, y); ``w7`` gets accelerations/forces."""
     a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)
@@ -234,7 +246,7 @@ def event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g, w7):
     return ok
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def event_slope(e, ms, y, w7):
     """Time derivative of the velocity-type event functions (0 for the others)."""
     if e == EV_G_SLIP:
@@ -246,7 +258,7 @@ def event_slope(e, ms, y, w7):
     return 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def start_slope(e, ms, y, acc_b, acc_s):
     """Slope of a velocity-type event function at the start of a step.
 
@@ -259,13 +271,13 @@ def start_slope(e, ms, y, acc_b, acc_s):
     return ms[MS_S] * y[Y_OM]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def has_slope(e):
     """Whether event ``e`` has a slope at the ends of a step (a velocity or the rotation)."""
     return e in (EV_G_SLIP, EV_S_SLIP, EV_IMPACT)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g):
     """Event function ``e`` after advancing ``y0`` by ``h`` (state left in ``y1``).
 
@@ -273,7 +285,7 @@ def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages,
     all event functions there, except for the events of the rotation alone (impact,
     overturning), which need no forces.
     """
-    advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, True, 1.0,
+    advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, np.bool_(True), 1.0,
             1.0)
     if e in (EV_IMPACT, EV_OVERTURN):
         return rotation_event(p, ms, e, y1[Y_TH])
@@ -281,7 +293,7 @@ def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages,
     return g[e]
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has_ay, sh, sv,
                 y1, stages, ytmp, w7, g):
     """Illinois iteration for the step length at which event ``e`` crosses zero.
@@ -332,19 +344,19 @@ def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has
     return hi
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def mode_number_of(slip1, rock, slip2):
     """Paper mode number (1..8) of the three interface flags."""
     return MODE_NUMBER[slip1, rock, slip2]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def mode_number(ms):
     """Paper mode number (1..8) of a mode state vector."""
     return mode_number_of(ms[MS_SLIP1], ms[MS_ROCK], ms[MS_SLIP2])
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def interface_option(v, i):
     """Option ``i`` (0..2) of an interface whose motion has velocity ``v``: (flag, sign, new).
 
@@ -360,7 +372,7 @@ def interface_option(v, i):
     return flag, (-1 if i == 2 else 1), flag
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def interface_violation(held, excess, new, push):
     """How much a candidate violates one interface's conditions (0 when it satisfies them).
 
@@ -375,7 +387,7 @@ def interface_violation(held, excess, new, push):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def candidate_options(idx, vb, rot, vs):
     """Interface options of candidate ``idx`` (0..26): three (flag, sign, new) triples.
 
@@ -430,7 +442,7 @@ def _candidate_order():
 CANDIDATE_KEYS, CANDIDATE_COUNTS = _candidate_order()
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def select_mode(p, y, ms, a, b, trigger, w7, work):
     """Choose the next mode among the candidates consistent with the velocities.
 
@@ -552,7 +564,7 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
 
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes, ev_t,
         ev_kft, summary, y_init):
     """Integrate one record.
@@ -606,7 +618,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
 
 # IEEE division (error_model="numpy") as in the closed-form span inlined here: the default
 # would add a zero test before every division
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, forceinline=False, error_model="numpy", _nrt=False)
 def integrate(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes,
               ev_t, ev_kft, summary, y_init, y, y1, yr, ytmp, f_end, stages, w7, w7b, K, g0, g1,
               gw, span_work, armed, ms):
@@ -660,10 +672,12 @@ summary, y_init
 
     for i in range(N_DYN):
         y[i] = y_init[i]
-    k = 0
+    # the sample index and "no trigger" typed int64 from the start, not as the literals 0 and
+    # -1: numba would compile every function they are passed to once more for the literal
+    k = np.int64(0)
     tau = 0.0
-    a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, 0, ONE_SIDED_DT, dt)
-    status = select_mode(p_vec, y, ms, a_next, b_next, -1, w7, span_work)
+    a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, k, ONE_SIDED_DT, dt)
+    status = select_mode(p_vec, y, ms, a_next, b_next, np.int64(-1), w7, span_work)
     if status == 2:
         failure = Failure.SEPARATION
         failure_time = 0.0
@@ -677,9 +691,9 @@ summary, y_init
     n_ev = 1
     if ms[MS_ROCK]:
         uplift = 1
-    event_values(p, ms, y, 0, 0.0, dt, ax, ay, has_ay, sh, sv, g0, w7)
+    event_values(p, ms, y, k, 0.0, dt, ax, ay, has_ay, sh, sv, g0, w7)
     if store:
-        store_sample(p, ms, y, hist, modes, 0, 0 if failure else mode_number(ms))
+        store_sample(p, ms, y, hist, modes, k, 0 if failure else mode_number(ms))
     h_rock = dt
     events_here = 0
     g0_stale = False
@@ -805,7 +819,7 @@ summary, y_init
                                 # first guess: the root of the step's quintic interpolant of theta
                                 c0, c1, c2, c3, c4, c5 = quintic_hermite(
                                     y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h)
-                                u = bracketed_root(c0, c1, c2, c3, c4, c5, lo / h, hi / h, False)
+                                u = bracketed_root(c0, c1, c2, c3, c4, c5, lo / h, hi / h, np.bool_(False))
                                 if u >= 0.0:
                                     guess = u * h
                             root = locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y, k, tau, dt,
@@ -961,7 +975,7 @@ summary, y_init
     ) + potential_energy(p, y[Y_TH])
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, forceinline=False, parallel=True)
 def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
              case_sv, rtol, atol, zeno_omega, n_workers, next_case, summaries):
     """Run many cases in parallel; each case is (record, parameter row, H scale, V scale).
