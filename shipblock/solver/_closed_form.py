@@ -27,7 +27,7 @@ for the general kernel to apply.
 The functions called once per span or per event are compiled without numba's reference
 counting (``_nrt=False``; they neither allocate nor return arrays): it would otherwise update
 the counts of all their array arguments on every call, atomically, and the record and output
-arrays are shared by the runs that ``run_many`` executes in parallel.
+arrays are shared by the runs that ``run_cases`` executes on several threads.
 """
 
 from __future__ import annotations

@@ -10,9 +10,11 @@ method on the step length (an impact starting from the root of the step's quinti
 interpolant). The state is advanced to the root, the event is applied, and the next mode is
 chosen among all candidate modes consistent with the velocities by :func:`select_mode`.
 
-Nothing here allocates per step; the kernels take only arrays and scalars. :func:`run` only
-allocates the work arrays: the loop itself (:func:`integrate`), mode selection and the functions
-it calls are compiled without reference counting, like the closed-form span (see
+Nothing here allocates per step; the kernels take only arrays and scalars.
+:func:`run_cases`, the one compiled entry point (:func:`run` and
+:func:`~shipblock.simulate_batch` call it), only allocates the work arrays: the loop itself
+(:func:`integrate`), mode selection and the functions it calls are compiled without reference
+counting, like the closed-form span (see
 :mod:`~shipblock.solver._closed_form`).
 
 Compilation. The small functions of the step (``forceinline=True`` throughout the solver's
@@ -33,7 +35,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from shipblock.equations import (
     I_FX,
@@ -563,11 +565,9 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
     return 1
 
 
-
-@njit(cache=True, forceinline=False)
 def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes, ev_t,
         ev_kft, summary, y_init):
-    """Integrate one record.
+    """Integrate one record: a batch of one case of :func:`run_cases`.
 
     Parameters
     ----------
@@ -601,19 +601,12 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     y_init : ndarray, shape (6,)
         Initial ``(x_b, theta, x_s, v_b, theta_dot, v_s)``.
     """
-    vectors = np.zeros((5, N_STATE))
-    stages = np.zeros((7, N_STATE))
-    w7 = np.zeros((2, N_SOLVE_OUT))
-    K = np.zeros((3, 3))
-    g = np.zeros((3, N_EVENTS))
-    # the closed-form spans' work array: response vectors of the non-rocking modes, solved
-    # once per run, and the like (see nonrocking_span)
-    span_work = np.zeros(N_SPAN_WORK)
-    armed = np.ones(N_EVENTS, dtype=np.bool_)
-    ms = np.zeros(6, dtype=np.int64)
-    integrate(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes,
-              ev_t, ev_kft, summary, y_init, vectors[0], vectors[1], vectors[2], vectors[3],
-              vectors[4], stages, w7[0], w7[1], K, g[0], g[1], g[2], span_work, armed, ms)
+    ints = np.zeros((3, 1), dtype=np.int64)  # record, parameter row, claim counter
+    run_cases(np.ascontiguousarray(p_vec).reshape(1, -1), ax, ay,
+              np.array([0, ax.shape[0]], dtype=np.int64), np.array([float(dt)]),
+              np.array([has_ay], dtype=np.bool_), ints[0], ints[1], np.array([float(sh)]),
+              np.array([float(sv)]), rtol, atol, zeno_omega, ints[2], summary.reshape(1, -1),
+              bool(store), hist, modes, ev_t, ev_kft, np.asarray(y_init, dtype=float))
 
 
 # IEEE division (error_model="numpy") as in the closed-form span inlined here: the default
@@ -622,7 +615,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
 def integrate(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes,
               ev_t, ev_kft, summary, y_init, y, y1, yr, ytmp, f_end, stages, w7, w7b, K, g0, g1,
               gw, span_work, armed, ms):
-    """The integration of :func:`run`, in work arrays allocated there.
+    """The integration of one case of :func:`run_cases`, in work arrays allocated there.
 
     Compiled without reference counting: numba would otherwise update the counts of the work
     arrays, atomically, around the functions inlined into the loop, which cost about a quarter
@@ -975,35 +968,94 @@ summary, y_init
     ) + potential_energy(p, y[Y_TH])
 
 
-@njit(cache=True, forceinline=False, parallel=True)
-def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
-             case_sv, rtol, atol, zeno_omega, n_workers, next_case, summaries):
-    """Run many cases in parallel; each case is (record, parameter row, H scale, V scale).
+@njit(cache=True, forceinline=False, nogil=True)
+def run_cases(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
+              case_sv, rtol, atol, zeno_omega, next_case, summaries, store, hist, modes, ev_t,
+              ev_kft, y_init):
+    """Run cases until none is left; each case is (record, parameter row, H scale, V scale).
+
+    The one compiled entry point of the solver: :func:`run` (one record, with its histories)
+    and :func:`~shipblock.simulate_batch` (many cases, summaries only) both call it, so that
+    the integration is compiled once, for one caller.
 
     Records are concatenated in ``acc_h``/``acc_v``; record ``r`` occupies
-    ``offsets[r]:offsets[r+1]``. Only summaries are produced. Each of ``n_workers`` workers
-    (one per thread) claims the next unclaimed case from the counter ``next_case`` (int64,
-    length 1, zero on entry) until none is left, so uneven case costs do not idle a thread.
-    The caller owns both: numba's ``get_num_threads`` in compiled code would keep this
-    function out of the on-disk cache, and the counter must live outside the compiled
-    function, whose optimiser does not see the atomic writes to an array it allocated.
+    ``offsets[r]:offsets[r+1]``. The caller claims the next unclaimed case from the counter
+    ``next_case`` (int64, length 1, zero at the start of the batch) until none is left, so that
+    several threads calling this at once on the same arguments share the cases out
+    dynamically: uneven case costs do not idle a thread, and a thread the operating system sets
+    aside holds up at most the one case it has claimed. The GIL is released (``nogil``) and
+    the threads are Python's (:mod:`shipblock.solver._threads`): no parallel region of
+    numba's, whose worker threads spin at its barrier, and which takes seconds more to compile.
+    The counter must live outside the compiled function, whose optimiser does not see the
+    atomic writes to an array it allocated.
+
+    Parameters
+    ----------
+    params : ndarray, shape (n_systems, n_parameters)
+        Parameter vectors, one row per system.
+    acc_h, acc_v, offsets, dts, has_v : ndarray
+        The records (see :class:`~shipblock.solver._inputs.RecordSet`); ``acc_v`` of a record
+        is ignored unless ``has_v``.
+    case_record, case_params, case_sh, case_sv : ndarray, shape (n_cases,)
+        Each case's record, parameter row and horizontal and vertical scale factors.
+    rtol, atol, zeno_omega : float
+        As for :func:`run`.
+    next_case : ndarray of int64, shape (1,)
+        The claim counter.
+    summaries : ndarray, shape (n_cases, N_SUMMARY)
+        Receives each case's summary.
+    store, hist, modes, ev_t, ev_kft : bool and ndarray
+        Histories and event log as for :func:`run`, for a batch of one case only (False and
+        empty arrays otherwise).
+    y_init : ndarray, shape (6,)
+        Initial state of every case.
     """
     n_cases = case_record.shape[0]
-    empty_hist = np.zeros((N_HIST, 0))
-    empty_modes = np.zeros(0, dtype=np.int64)
-    empty_t = np.zeros(0)
-    empty_kft = np.zeros((3, 0), dtype=np.int64)
-    at_rest = np.zeros(N_DYN)
-    # a run-time False: a literal would make numba compile ``run`` a second time for it
-    store = n_cases < 0
-    for _ in prange(min(n_workers, n_cases)):
-        while True:
-            c = claim_next(next_case)
-            if c >= n_cases:
-                break
-            r = case_record[c]
-            a0 = offsets[r]
-            a1 = offsets[r + 1]
-            run(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
-                case_sv[c], dts[r], rtol, atol, zeno_omega, store, empty_hist, empty_modes,
-                empty_t, empty_kft, summaries[c], at_rest)
+    # the work arrays of integrate, allocated once per call and reset for every case
+    vectors = np.zeros((5, N_STATE))
+    stages = np.zeros((7, N_STATE))
+    w7 = np.zeros((2, N_SOLVE_OUT))
+    K = np.zeros((3, 3))
+    g = np.zeros((3, N_EVENTS))
+    # the closed-form spans' work array: response vectors of the non-rocking modes, solved
+    # once per run, and the like (see nonrocking_span)
+    span_work = np.zeros(N_SPAN_WORK)
+    armed = np.ones(N_EVENTS, dtype=np.bool_)
+    ms = np.zeros(6, dtype=np.int64)
+    first = True
+    while True:
+        c = claim_next(next_case)
+        if c >= n_cases:
+            break
+        if not first:
+            # every case starts from the work arrays as allocated: zeros, all events armed
+            _reset_work(vectors, stages, w7, K, g, span_work, armed, ms)
+        first = False
+        r = case_record[c]
+        a0 = offsets[r]
+        a1 = offsets[r + 1]
+        integrate(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
+                  case_sv[c], dts[r], rtol, atol, zeno_omega, store, hist, modes, ev_t, ev_kft,
+                  summaries[c], y_init, vectors[0], vectors[1], vectors[2], vectors[3],
+                  vectors[4], stages, w7[0], w7[1], K, g[0], g[1], g[2], span_work, armed, ms)
+
+
+def no_histories():
+    """Empty ``(hist, modes, ev_t, ev_kft)`` for :func:`run_cases` without histories."""
+    return (np.zeros((N_HIST, 0)), np.zeros(0, dtype=np.int64), np.zeros(0),
+            np.zeros((3, 0), dtype=np.int64))
+
+
+@njit(cache=True, forceinline=True, _nrt=False)
+def _reset_work(vectors, stages, w7, K, g, span_work, armed, ms):
+    """The work arrays of :func:`run_cases` back to their state as allocated."""
+    for a in (vectors, stages, w7, K, g):
+        for i in range(a.shape[0]):
+            for j in range(a.shape[1]):
+                a[i, j] = 0.0
+    for i in range(span_work.shape[0]):
+        span_work[i] = 0.0
+    for i in range(armed.shape[0]):
+        armed[i] = True
+    for i in range(ms.shape[0]):
+        ms[i] = 0
