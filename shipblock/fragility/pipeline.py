@@ -136,6 +136,7 @@ from shipblock.fragility.limit_states import (
     parse_limit_states,
 )
 from shipblock.fragility.store import ChunkStore, StoreError, open_results, write_dataset
+from shipblock.fragility.workers import Workers
 from shipblock.solver import DEFAULT_ATOL, DEFAULT_RTOL, DEFAULT_ZENO_OMEGA
 from shipblock.system import ShipBlockSystem
 from shipblock.units import STANDARD_GRAVITY, acceleration_to_si, velocity_to_si
@@ -761,7 +762,7 @@ def _check_chain(chain, source):
 # --------------------------------------------------------------------------------------------
 
 
-def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng):
+def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng, workers=None):
     """Fit one limit state for one parameter combination; returns a dict of results."""
     out = {"median": np.nan, "beta": np.nan, "median_lower": np.nan, "median_upper": np.nan,
            "beta_lower": np.nan, "beta_upper": np.nan, "fit_method": "", "fit_error": "",
@@ -794,7 +795,7 @@ def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng):
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", RuntimeWarning)
                     b = bootstrap(fn, args, n_boot=n_boot, confidence=fit_opts["confidence"],
-                                  seed=rng, **kw)
+                                  seed=rng, workers=workers, **kw)
                 out.update(median_lower=b.fit.median_ci[0], median_upper=b.fit.median_ci[1],
                            beta_lower=b.fit.beta_ci[0], beta_upper=b.fit.beta_ci[1],
                            bootstrap_failed=b.n_failed)
@@ -805,7 +806,8 @@ def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng):
     return out, capacity
 
 
-def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fit_opts) -> dict:
+def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fit_opts,
+                        workers=None) -> dict:
     """Exceedance, fitted median/beta and bootstrap bounds of every limit state.
 
     Parameters
@@ -819,6 +821,8 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
         The limit states (the ``limit_state`` dimension).
     fit_opts : dict
         ``bootstrap`` (resamples), ``confidence``, ``seed``, ``ida_method``, ``cloud_method``.
+    workers : shipblock.fragility.workers.Workers, optional
+        Where the bootstrap resamples run (see :func:`~shipblock.fragility.fit.bootstrap`).
 
     Returns
     -------
@@ -855,7 +859,7 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
             sel = (slice(None),) * lead + combo
             rng = np.random.default_rng([int(fit_opts["seed"]), i, c])
             res, caps = _fit_one(kind, e_all[sel], w_all[sel], levels, im, edp_all[sel], ls,
-                                 fit_opts, rng)
+                                 fit_opts, rng, workers)
             for k, v in res.items():
                 fields[k][(i, *combo)] = v
             if caps is not None:
@@ -1027,14 +1031,16 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     try:
         results = run_batch(design, records, store, chunk_size=pipe.chunk_size, client=client,
                             progress=progress, solver_options=pipe.solver, timings=timings)
+        clock.lap("runs")
+        ds = summary_dataset(design, records, results)
+        ds = ds.assign_coords({k: xr.Variable(*v) for k, v in _limit_state_coords(
+            pipe.limit_states).items()})
+        # the bootstrap resamples on the client's workers too, or on local processes
+        with Workers(client) as workers:
+            ds = ds.assign(fragility_variables(ds, design, pipe.limit_states, pipe.fit, workers))
     finally:
         if own_client is not None:
             own_client.close()
-    clock.lap("runs")
-    ds = summary_dataset(design, records, results)
-    ds = ds.assign_coords({k: xr.Variable(*v) for k, v in _limit_state_coords(
-        pipe.limit_states).items()})
-    ds = ds.assign(fragility_variables(ds, design, pipe.limit_states, pipe.fit))
     chain = [dict(e) for e in (DEFAULT_CHAIN if pipe.chain is None else pipe.chain)]
     intensity = design.intensity
     ds.attrs = {
