@@ -437,7 +437,7 @@ def _mb(n):
 
 
 def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campaign_runs=None,
-                   chunk_size=None, profile=None):
+                   chunk_size=None, profile=None, cold=True, dask_workers=None):
     """Run all benchmarks and print a report.
 
     Parameters
@@ -457,6 +457,12 @@ def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campai
         Cases per chunk of the campaign (default: about 100 chunks).
     profile : str or os.PathLike, optional
         Profile the campaign with :mod:`cProfile` and write the statistics to this file.
+    cold : bool
+        Include the cold start (:func:`shipblock.bench_startup.cold_start`: the demo command
+        from an empty numba cache, in subprocesses).
+    dask_workers : sequence of int, optional
+        Also run :func:`shipblock.bench_parallel.dask_scaling` on LocalClusters of these numbers
+        of worker processes.
 
     Returns
     -------
@@ -520,6 +526,11 @@ def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campai
               f"{scaling['machine_speedup']:.3f}x (best calls of {scaling['rounds']} rounds; "
               f"median of the rounds' ratios: batch {scaling['speedup_median']:.2f}x, "
               f"loop {scaling['machine_speedup_median']:.2f}x)\n")
+    from shipblock.bench_parallel import busy_core_batch, write_busy_core
+
+    busy = busy_core_batch(min_seconds=1.0 if quick else 3.0, copies=(1,) if quick else (1, 10))
+    results["busy_core"] = busy
+    write_busy_core(out, busy)
     if pyslammer:
         ps = pyslammer_comparison()
         if ps is None:
@@ -545,6 +556,18 @@ def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campai
                       f"{ps['pyslammer_s_per_record'] / ps['simulate_s_per_record']:.2g}x "
                       f"(per record: median {np.median(sp):.2g}x, min {sp.min():.2g}x, "
                       f"max {sp.max():.2g}x)\n")
+    if cold:
+        from shipblock.bench_startup import cold_start, write_cold_start
+
+        out.flush()
+        results["cold_start"] = cold_start()
+        write_cold_start(out, results["cold_start"])
+    if dask_workers:
+        from shipblock.bench_parallel import dask_scaling, write_dask_scaling
+
+        out.flush()
+        results["dask"] = dask_scaling(dask_workers, quick=quick)
+        write_dask_scaling(out, results["dask"])
     if campaign_runs:
         out.flush()
         c = campaign(campaign_runs, chunk_size=chunk_size, profile=profile)

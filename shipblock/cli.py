@@ -559,9 +559,18 @@ def cmd_bench(args):
         raise UserError(f"--campaign-runs must be >= 0, got {args.campaign_runs}")
     if args.chunk_size is not None and args.chunk_size < 1:
         raise UserError(f"--chunk-size must be >= 1, got {args.chunk_size}")
+    dask_workers = None
+    if args.dask:
+        try:
+            dask_workers = [int(n) for n in args.dask.split(",")]
+        except ValueError:
+            raise UserError(f"--dask takes numbers of workers like 1,2; got {args.dask!r}") from None
+        if min(dask_workers) < 1:
+            raise UserError(f"--dask: numbers of workers must be >= 1, got {args.dask!r}")
     return run_benchmarks(quick=args.quick, pyslammer=not args.no_pyslammer, output=args.output,
                           campaign_runs=args.campaign_runs, chunk_size=args.chunk_size,
-                          profile=args.profile)
+                          profile=args.profile, cold=not args.no_cold_start,
+                          dask_workers=dask_workers)
 
 
 # --------------------------------------------------------------------------- parser
@@ -660,6 +669,12 @@ def build_parser():
                    help="cases per chunk of the campaign (default: about 100 chunks)")
     s.add_argument("--profile", metavar="FILE",
                    help="profile the campaign with cProfile and write the statistics to FILE")
+    s.add_argument("--no-cold-start", action="store_true",
+                   help="skip the cold start (the demo command from an empty numba cache)")
+    s.add_argument("--dask", metavar="N[,N...]",
+                   help="also run a pipeline on Dask LocalClusters of these numbers of worker "
+                        "processes (e.g. 1,2): runs/s per worker, scaling, equality with the "
+                        "local run")
     s.add_argument("--read", nargs="+", metavar="SOURCE",
                    help="only the readers' benchmark: files/s per format on these folders, globs"
                         " or files")

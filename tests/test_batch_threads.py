@@ -15,13 +15,15 @@ from shipblock.solver import _threads
     ("requested", "n_cases", "n_samples", "others", "cores", "expected"),
     [
         (2, 1, 1e9, 0, 2, 1),  # one case: one thread
-        (2, 50, 1e3, 0, 2, 2),  # a quiet machine: all threads
-        (2, 50, 1e3, 1, 2, 1),  # a short batch beside a busy core: the free core only
-        (2, 50, 1e3, 5, 2, 1),  # never fewer than one
+        (2, 50, 1e6, 0, 2, 2),  # a quiet machine: all threads
+        (2, 50, 1e6, 1, 2, 1),  # a short batch beside a busy core: the free core only
+        (2, 50, 1e6, 5, 2, 1),  # never fewer than one
+        (2, 50, None, 1, 2, 1),  # unknown length: as a short batch
         (2, 50, 1e9, 1, 2, 2),  # a long batch gains from a shared core: all threads
+        (2, 50, 1e4, 0, 2, 1),  # a tiny batch: not worth starting a thread
         (8, 50, 1e9, 0, 2, 2),  # no more threads than usable cores
         (1, 50, 1e9, 0, 4, 1),  # no more than requested
-        (4, 3, 1e3, 0, 4, 3),  # no more than cases
+        (4, 3, 1e6, 0, 4, 3),  # no more than cases
     ],
 )
 def test_batch_threads(requested, n_cases, n_samples, others, cores, expected):
@@ -53,6 +55,27 @@ def test_other_runnable_unknown_in_a_cpu_subset(tmp_path, monkeypatch):
     fake.write_text("0.52 0.41 0.30 3/120 9999\n")
     monkeypatch.setattr(_threads, "usable_cores", lambda: (os.cpu_count() or 2) + 1)
     assert _threads.other_runnable(str(fake)) is None
+
+
+@pytest.mark.parametrize(("files", "expected"), [
+    ({"cpu.max": "150000 100000\n"}, 1.5),  # cgroup v2, a limit of 1.5 CPUs
+    ({"cpu.max": "max 100000\n"}, None),  # v2, no limit
+    ({"cpu/cpu.cfs_quota_us": "200000\n", "cpu/cpu.cfs_period_us": "100000\n"}, 2.0),  # v1
+    ({"cpu/cpu.cfs_quota_us": "-1\n", "cpu/cpu.cfs_period_us": "100000\n"}, None),
+    ({}, None),  # no cgroup file system
+])
+def test_cgroup_cpu_quota(tmp_path, files, expected):
+    for name, text in files.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text)
+    assert _threads.cgroup_cpu_quota(str(tmp_path)) == expected
+
+
+def test_usable_cores_honours_a_quota(monkeypatch):
+    monkeypatch.setattr(_threads, "cgroup_cpu_quota", lambda: 1.5)
+    assert _threads.usable_cores() == min(2, len(os.sched_getaffinity(0)))
+    monkeypatch.setattr(_threads, "cgroup_cpu_quota", lambda: 0.2)
+    assert _threads.usable_cores() == 1
 
 
 def test_run_on_threads_calls_on_distinct_threads_and_raises():

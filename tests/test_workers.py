@@ -145,6 +145,7 @@ def test_pipeline_on_a_two_process_cluster_equals_the_local_run(cluster_client, 
                                                                 monkeypatch):
     """Runs and bootstrap (sent to the cluster whatever its length) bit for bit as locally."""
     path = write_pipeline(tmp_path, sweep='\n[sweep]\nmu_ground = [0.3, 0.6]\n')
+    path.write_text(path.read_text().replace("bootstrap = 20", "bootstrap = 60"))
     local = run_pipeline(path, output=tmp_path / "local.nc", progress=False)
     used = []
 

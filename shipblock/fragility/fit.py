@@ -929,8 +929,8 @@ def bootstrap(
         random state is used.
     workers : shipblock.fragility.workers.Workers, optional
         Where the replicates run, in blocks: a Dask client, local processes, or here (default),
-        depending on the time the replicates are estimated to take here (the first fit's time
-        times ``n_boot``). ``fit_function`` and the arrays must then be picklable (the fits of
+        depending on the time the others are estimated to take here, from the time of the first
+        ``PROBE_REPLICATES`` (run here). ``fit_function`` and the arrays must then be picklable (the fits of
         this module are).
     **fit_kwargs
         Arguments that are not resampled (``im_levels=...``, ``capacity=...``, ...).
@@ -959,23 +959,27 @@ def bootstrap(
         raise ParameterError(f"all record arrays need the same length along axis 0, got {lengths}")
     (n_rec,) = n_rec
     seeds = _replicate_seeds(seed, int(n_boot))
-    t0 = time.perf_counter()
     base = fit_function(**arrays, **fit_kwargs)
-    estimate = (time.perf_counter() - t0) * len(seeds)  # seconds the replicates take here
     grid = (
         base.median
         * np.exp(np.linspace(-_GRID_HALF_WIDTH, _GRID_HALF_WIDTH, _GRID_POINTS) * base.beta)
         if im is None
         else np.asarray(im, dtype=float)
     )
-    if workers is None or len(seeds) < 2:
+    if workers is None:
         parts = [_bootstrap_block(fit_function, arrays, fit_kwargs, seeds)]
     else:
-        from shipblock.fragility.workers import blocks
+        from shipblock.fragility.workers import PROBE_REPLICATES, blocks
 
-        items = [(fit_function, arrays, fit_kwargs, seeds[b.start:b.stop])
-                 for b in blocks(len(seeds), workers.slots())]
-        parts = workers.map(_bootstrap_block, items, estimated_seconds=estimate)
+        # the first replicates here, timed: the estimate of where the others should go
+        t0 = time.perf_counter()
+        parts = [_bootstrap_block(fit_function, arrays, fit_kwargs, seeds[:PROBE_REPLICATES])]
+        rest = seeds[PROBE_REPLICATES:]
+        if rest:
+            estimate = (time.perf_counter() - t0) / PROBE_REPLICATES * len(rest)
+            items = [(fit_function, arrays, fit_kwargs, rest[b.start:b.stop])
+                     for b in blocks(len(rest), workers.slots())]
+            parts += workers.map(_bootstrap_block, items, estimated_seconds=estimate)
     fitted = np.concatenate(parts, axis=1) if parts else np.zeros((2, 0))
     ok = np.isfinite(fitted[0])
     medians, betas = fitted[0, ok].tolist(), fitted[1, ok].tolist()

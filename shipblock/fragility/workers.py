@@ -35,6 +35,9 @@ LOCAL_POOL_SECONDS = 2.0
 #: round trip of a few tasks costs tens of milliseconds.
 DASK_SECONDS = 0.05
 
+#: Bootstrap replicates run here first, timed, to estimate how long the others would take.
+PROBE_REPLICATES = 16
+
 #: Blocks of resamples per parallel slot (worker thread or process): several, so that a slow
 #: slot does not hold the others up; but at least :data:`MIN_BLOCK` resamples a block.
 BLOCKS_PER_SLOT = 4
@@ -200,4 +203,4 @@ def timed(fn: Callable, *args, **kwargs):
 
 
 __all__ = ["Workers", "blocks", "host_task_threads", "numba_threads_per_task", "run_chunk_task",
-           "timed", "LOCAL_POOL_SECONDS", "DASK_SECONDS"]
+           "timed", "LOCAL_POOL_SECONDS", "DASK_SECONDS", "PROBE_REPLICATES"]
