@@ -263,8 +263,9 @@ def rest_breaks(ax_j, ay_j, has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, 
     At rest nothing moves, so the screen is :func:`held_fails_at` of the input at the end
     sample alone.
     """
-    return held_fails_at(0, 0, sh * ax_j, grav + (sv * ay_j if has_ay else 0.0), fx_a, fx_g,
-                         fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
+    return held_fails_at(np.int64(0), np.int64(0), sh * ax_j,
+                         grav + (sv * ay_j if has_ay else 0.0), fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g,
+                         Fy_a, Fy_g, mus1, mus2, B, H)
 
 
 @njit(cache=True, forceinline=False, error_model="numpy")
@@ -667,9 +668,10 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         moving_s = slip2 or vs0 != 0.0
         if moving_b or moving_s:
             if not moving_s:
-                exact_update_one(y, Y_XB, Y_VB, h, ub0, ub1, a0, a1, fx0, fx1, mass_b)
+                exact_update_one(y, np.int64(Y_XB), np.int64(Y_VB), h, ub0, ub1, a0, a1, fx0, fx1,
+                                 mass_b)
             elif not moving_b:
-                exact_update_one(y, Y_XS, Y_VS, h, us0, us1, a0, a1, Fx0, Fx1, M)
+                exact_update_one(y, np.int64(Y_XS), np.int64(Y_VS), h, us0, us1, a0, a1, Fx0, Fx1, M)
             else:
                 exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M)
             axb = abs(y[Y_XB])

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from shipblock.solver._layout import (
@@ -75,8 +76,8 @@ def event_functions(p, ms, y, fx, fy, Fx, Fy, g):
     else:
         g[EV_G_STICK] = (p[P_MUS1] * fy - abs(fx)) / weight
     if ms[MS_ROCK]:
-        g[EV_IMPACT] = rotation_event(p, ms, EV_IMPACT, y[Y_TH])
-        g[EV_OVERTURN] = rotation_event(p, ms, EV_OVERTURN, y[Y_TH])
+        g[EV_IMPACT] = rotation_event(p, ms, np.int64(EV_IMPACT), y[Y_TH])
+        g[EV_OVERTURN] = rotation_event(p, ms, np.int64(EV_OVERTURN), y[Y_TH])
     else:
         g[EV_UPLIFT] = (p[P_B] * (fy + Fy) - p[P_H] * abs(fx + Fx)) / (weight * p[P_R])
     if ms[MS_SLIP2]:

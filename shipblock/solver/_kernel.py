@@ -750,7 +750,7 @@ summary, y_init
                         failure_time = k * dt + tau
                         break
                     continue
-                t_return = impact_return_time(ms[MS_S], y[Y_TH], y[Y_OM], stages[0, Y_OM])
+                t_return = impact_return_time(float(ms[MS_S]), y[Y_TH], y[Y_OM], stages[0, Y_OM])
                 if h > t_return >= MIN_STEP:
                     # from an impact, no step past the rotation's return to zero: see
                     # impact_return_time (stages[0] stays f(y) for the shorter step)

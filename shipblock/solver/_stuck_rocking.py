@@ -359,7 +359,7 @@ def advance_stuck(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, 
         pw1 = stages[0, Y_WIN]
     else:
         al1, pw1 = stuck_rocking_rates(p, gain, c0, s0, s, om0, a0 + da * f0, b0 + db * f0)
-        _store_rates(y0, om0, al1, pw1, stages, 0)
+        _store_rates(y0, om0, al1, pw1, stages, np.int64(0))
     th1, om1, w1, al7, pw7, c7, sn7, e_th, e_om = stuck_step(
         p, gain, s, c0, s0, th0, om0, y0[Y_WIN], al1, pw1, a0, da, b0, db, f0, h / dt, h)
     for i in range(N_STATE):
@@ -367,7 +367,7 @@ def advance_stuck(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, 
     y1[Y_TH] = th1
     y1[Y_OM] = om1
     y1[Y_WIN] = w1
-    _store_rates(y0, om1, al7, pw7, stages, 6)
+    _store_rates(y0, om1, al7, pw7, stages, np.int64(6))
     f = (tau + h) / dt
     stuck_forces_into(p, s, c7, sn7, om1, al7, a0 + da * f, b0 + db * f, w7)
     return stuck_error_norm(th0, om0, th1, om1, e_th, e_om, rtol, atol)
