@@ -100,6 +100,17 @@ def test_short_bootstrap_stays_here():
         assert workers.used == ["here"] and workers._pool is None
 
 
+def test_many_short_bootstraps_pay_for_the_pool_together():
+    """Work run here adds up: once it reaches the threshold, the pool takes the rest."""
+    workers = W.Workers(processes=2, local_pool_seconds=1.0)
+    items = [(1, 2), (3, 4)]
+    assert workers.map(max, items, estimated_seconds=0.4) == [2, 4]
+    assert workers.map(max, items, estimated_seconds=0.4) == [2, 4]
+    assert workers.used == ["here", "here"] and workers.here_seconds == pytest.approx(0.8)
+    assert workers.where(0.4) == "processes"  # 0.8 s done here + 0.4 s: the pool pays
+    assert W.Workers(processes=1, local_pool_seconds=1.0).where(5.0) == "here"  # one core
+
+
 # -------------------------------------------------------------------------------------------
 # a Dask cluster of two worker processes
 # -------------------------------------------------------------------------------------------

@@ -12,8 +12,9 @@ Two concerns of a study spread over cores or over a Dask cluster:
   one thread on 8 cores, eight.
 * **The bootstrap's resamples.** :class:`Workers` maps blocks of resamples
   (:func:`~shipblock.fragility.fit.bootstrap`) onto a Dask client when one is given, else onto
-  a pool of local processes when the resamples would take long enough here
-  (:data:`LOCAL_POOL_SECONDS`) to pay for starting it, else runs them here. Each resample has
+  a pool of local processes once the resamples run here would take long enough
+  (:data:`LOCAL_POOL_SECONDS`, counting those of the fits before) to pay for starting it, else
+  runs them here. Each resample has
   its own seed (``numpy.random.SeedSequence.spawn``), so the result does not depend on where or
   in what blocks the resamples ran.
 """
@@ -129,6 +130,8 @@ class Workers:
                                         else local_pool_seconds)
         self.dask_seconds = float(DASK_SECONDS if dask_seconds is None else dask_seconds)
         self._pool = None
+        #: estimated seconds of the work run here so far
+        self.here_seconds = 0.0
         #: where each :meth:`map` ran: "here", "processes" or "dask" (for reports and tests)
         self.used: list[str] = []
 
@@ -152,10 +155,17 @@ class Workers:
         return self.processes
 
     def where(self, estimated_seconds: float) -> str:
-        """Where work estimated at ``estimated_seconds`` here would run."""
+        """Where work estimated at ``estimated_seconds`` here would run.
+
+        On the client if it is estimated at :attr:`dask_seconds` or more. Without a client, on
+        the local processes once the work run here, this included, reaches
+        :attr:`local_pool_seconds` (many short bootstraps pay for the pool as one long one
+        does) and from then on, the pool being started.
+        """
         if self.client is not None:
             return "dask" if estimated_seconds >= self.dask_seconds else "here"
-        if self.processes > 1 and estimated_seconds >= self.local_pool_seconds:
+        if self.processes > 1 and (self._pool is not None or self.here_seconds + estimated_seconds
+                                   >= self.local_pool_seconds):
             return "processes"
         return "here"
 
@@ -167,6 +177,8 @@ class Workers:
         items = list(items)
         where = self.where(estimated_seconds) if len(items) > 1 else "here"
         self.used.append(where)
+        if where == "here" and estimated_seconds != float("inf"):
+            self.here_seconds += estimated_seconds
         if where == "dask":
             futures = [self.client.submit(fn, *item, pure=False) for item in items]
             return self.client.gather(futures)
