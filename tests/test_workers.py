@@ -111,6 +111,29 @@ def test_many_short_bootstraps_pay_for_the_pool_together():
     assert W.Workers(processes=1, local_pool_seconds=1.0).where(5.0) == "here"  # one core
 
 
+def test_spawned_processes_only_where_the_main_script_is_guarded(tmp_path, monkeypatch):
+    import sys
+    import types
+
+    def main(source=None, spec=None):
+        module = types.ModuleType("__main__")
+        if source is not None:
+            path = tmp_path / f"script{len(list(tmp_path.iterdir()))}.py"
+            path.write_text(source)
+            module.__file__ = str(path)
+        module.__spec__ = spec
+        monkeypatch.setitem(sys.modules, "__main__", module)
+
+    main()  # an interactive session, python -c
+    assert W.main_is_safe_to_spawn()
+    main("import shipblock\nshipblock.run_pipeline('study.toml')\n")  # would run again
+    assert not W.main_is_safe_to_spawn()
+    main("import shipblock\nif __name__ == '__main__':\n    shipblock.run_pipeline('s.toml')\n")
+    assert W.main_is_safe_to_spawn()
+    main("", spec=types.SimpleNamespace(name="shipblock.cli"))  # python -m shipblock.cli
+    assert W.main_is_safe_to_spawn()
+
+
 # -------------------------------------------------------------------------------------------
 # a Dask cluster of two worker processes
 # -------------------------------------------------------------------------------------------

@@ -12,25 +12,30 @@ Two concerns of a study spread over cores or over a Dask cluster:
   one thread on 8 cores, eight.
 * **The bootstrap's resamples.** :class:`Workers` maps blocks of resamples
   (:func:`~shipblock.fragility.fit.bootstrap`) onto a Dask client when one is given, else onto
-  a pool of local processes once the resamples run here would take long enough
-  (:data:`LOCAL_POOL_SECONDS`, counting those of the fits before) to pay for starting it, else
-  runs them here. Each resample has
+  a pool of local processes (forked on Linux) once the resamples run here would take long
+  enough (:data:`LOCAL_POOL_SECONDS`, counting those of the fits before) to pay for starting
+  it, else runs them here. Each resample has
   its own seed (``numpy.random.SeedSequence.spawn``), so the result does not depend on where or
   in what blocks the resamples ran.
 """
 
 from __future__ import annotations
 
+import sys
 import time
+import warnings
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from urllib.parse import urlparse
 
 from shipblock.solver._threads import usable_cores
 
-#: Serial estimate [s] above which the bootstrap's resamples go to local processes (without
-#: Dask): starting a pool of spawned processes (each importing numpy and scipy) takes about a
-#: second, so a shorter bootstrap runs here.
-LOCAL_POOL_SECONDS = 2.0
+#: Serial estimate [s] from which the bootstrap's resamples go to local processes (without
+#: Dask), counting those already run here: on Linux the pool's processes are forked, which
+#: takes some 20 ms; elsewhere they are spawned, each importing numpy and scipy (about a
+#: second), and the estimate must reach :data:`SPAWN_POOL_SECONDS`.
+LOCAL_POOL_SECONDS = 0.2
+SPAWN_POOL_SECONDS = 2.0
 
 #: Serial estimate [s] above which the resamples go to the Dask client when there is one: a
 #: round trip of a few tasks costs tens of milliseconds.
@@ -119,14 +124,26 @@ class Workers:
         everything here.
     local_pool_seconds, dask_seconds : float, optional
         Serial estimates [s] from which work goes to local processes or to the client
-        (default :data:`LOCAL_POOL_SECONDS`, :data:`DASK_SECONDS`); 0 sends all of it.
+        (default :data:`LOCAL_POOL_SECONDS`, or :data:`SPAWN_POOL_SECONDS` where processes are
+        spawned, and :data:`DASK_SECONDS`); 0 sends all of it.
+
+    Notes
+    -----
+    On Linux the local processes are forked: they start in milliseconds and do not import the
+    caller's main module again. Elsewhere they are spawned, which runs the main script again in
+    each process: the pool is then used only when that is safe (:func:`main_is_safe_to_spawn`).
     """
 
     def __init__(self, client=None, processes: int | None = None,
                  local_pool_seconds: float | None = None, dask_seconds: float | None = None):
         self.client = client
         self.processes = usable_cores() if processes is None else max(1, int(processes))
-        self.local_pool_seconds = float(LOCAL_POOL_SECONDS if local_pool_seconds is None
+        self._context = pool_context()
+        if self._context.get_start_method() != "fork" and not main_is_safe_to_spawn():
+            self.processes = 1
+        default = LOCAL_POOL_SECONDS if self._context.get_start_method() == "fork" else \
+            SPAWN_POOL_SECONDS
+        self.local_pool_seconds = float(default if local_pool_seconds is None
                                         else local_pool_seconds)
         self.dask_seconds = float(DASK_SECONDS if dask_seconds is None else dask_seconds)
         self._pool = None
@@ -184,14 +201,46 @@ class Workers:
             return self.client.gather(futures)
         if where == "processes":
             if self._pool is None:
-                import multiprocessing
                 from concurrent.futures import ProcessPoolExecutor
 
-                # spawned, not forked: this process has threads (numba, progress bars)
                 self._pool = ProcessPoolExecutor(max_workers=self.processes,
-                                                 mp_context=multiprocessing.get_context("spawn"))
-            return [f.result() for f in [self._pool.submit(fn, *item) for item in items]]
+                                                 mp_context=self._context)
+            with warnings.catch_warnings():
+                # Python 3.12+ warns that forking a process with threads may deadlock the
+                # child; the children only fit (numpy, scipy) and hold no lock of ours
+                warnings.simplefilter("ignore", DeprecationWarning)
+                futures = [self._pool.submit(fn, *item) for item in items]
+            return [f.result() for f in futures]
         return [fn(*item) for item in items]
+
+
+def pool_context():
+    """The multiprocessing context of local pools: forked on Linux, spawned elsewhere."""
+    import multiprocessing
+
+    return multiprocessing.get_context("fork" if sys.platform.startswith("linux") else "spawn")
+
+
+def main_is_safe_to_spawn() -> bool:
+    """Whether spawned processes can import the main module again without re-running work.
+
+    A spawned process imports the caller's main script as ``__mp_main__``: harmless for an
+    interactive session, ``python -c``, a notebook, shipblock's command line, or a script whose
+    work is under ``if __name__ == "__main__":``; a script without that guard would run again,
+    pipeline and all, in every process.
+    """
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if path is None:
+        return True
+    name = getattr(getattr(main, "__spec__", None), "name", "") or ""
+    if name.split(".")[0] == "shipblock":
+        return True
+    try:
+        source = Path(path).read_text(errors="replace")
+    except OSError:
+        return False
+    return "__name__ == \"__main__\"" in source or "__name__ == '__main__'" in source
 
 
 def blocks(n: int, slots: int) -> list[range]:
@@ -214,5 +263,6 @@ def timed(fn: Callable, *args, **kwargs):
     return out, time.perf_counter() - t0
 
 
-__all__ = ["Workers", "blocks", "host_task_threads", "numba_threads_per_task", "run_chunk_task",
-           "timed", "LOCAL_POOL_SECONDS", "DASK_SECONDS", "PROBE_REPLICATES"]
+__all__ = ["Workers", "blocks", "host_task_threads", "main_is_safe_to_spawn",
+           "numba_threads_per_task", "pool_context", "run_chunk_task", "timed",
+           "LOCAL_POOL_SECONDS", "SPAWN_POOL_SECONDS", "DASK_SECONDS", "PROBE_REPLICATES"]
