@@ -9,7 +9,13 @@ documentation's benchmark page quotes a run of this command.
 * speed-up of :func:`~shipblock.simulate_batch` from one core to all;
 * time per record against pySLAMMER (:func:`pyslammer_comparison`);
 * a campaign of a generated pipeline through :func:`~shipblock.fragility.pipeline.run_pipeline`
-  in a subprocess: wall time, stages and memory (:func:`campaign`).
+  in a subprocess: wall time, stages and memory (:func:`campaign`);
+* a batch on one thread and on all, beside a busy process
+  (:func:`shipblock.bench_parallel.busy_core_batch`);
+* the README's demo command from an empty numba cache
+  (:func:`shipblock.bench_startup.cold_start`);
+* with ``--dask``, a pipeline on LocalClusters of 1 and 2 workers
+  (:func:`shipblock.bench_parallel.dask_scaling`).
 """
 
 from __future__ import annotations
