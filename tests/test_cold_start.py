@@ -83,3 +83,28 @@ def test_notice_names_the_part_and_its_measured_time():
 def test_every_solver_module_is_a_known_part(module):
     __import__(module)
     assert compiled_part(module)[0] == "the solver"
+
+
+def test_read_only_records_use_the_same_compiled_solver():
+    """numba types a read-only array apart; simulate must not compile the solver again for one."""
+    import numpy as np
+
+    from shipblock import ShipBlockSystem, simulate
+    from shipblock.solver import _kernel
+
+    system = ShipBlockSystem(ship_mass=2e5, block_mass=500.0, n_blocks=8, half_width=0.3,
+                             half_height=0.6, mu_s_ground=0.3, mu_k_ground=0.25, mu_s_ship=0.7,
+                             mu_k_ship=0.6)
+    t = np.arange(1500) * 0.01
+    ax = 4.0 * np.sin(2 * np.pi * 1.5 * t)
+    ay = 0.3 * ax
+    writable = simulate(system, ax, ay, 0.01)
+    signatures = len(_kernel.run_cases.signatures)
+    ax.flags.writeable = False
+    ay.flags.writeable = False
+    read_only = simulate(system, ax, ay, 0.01)
+    horizontal_only = simulate(system, ax, None, 0.01)
+    assert len(_kernel.run_cases.signatures) == signatures
+    np.testing.assert_array_equal(read_only.x_b, writable.x_b)
+    assert writable.summary["peak_block_slip"] > 0.0  # the record does move the blocks
+    assert horizontal_only.summary["peak_block_slip"] > 0.0

@@ -286,8 +286,9 @@ def simulate_batch(
 
     The threads are at most :func:`numba.get_num_threads` (set it with
     :func:`numba.set_num_threads`), one per case and one per CPU this process may run on; a
-    short batch (under about 20 ms of work per thread) leaves the cores other programs keep busy
-    to them, so that it never runs slower on all threads than on one
+    batch of under a millisecond of work runs on one thread, and a short batch (under about
+    20 ms of work per thread) leaves the cores other programs keep busy to them, so that it
+    never runs slower on all threads than on one
     (:func:`shipblock.solver._threads.batch_threads`).
 
     Parameters

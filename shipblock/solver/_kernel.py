@@ -602,6 +602,12 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
         Initial ``(x_b, theta, x_s, v_b, theta_dot, v_s)``.
     """
     ints = np.zeros((3, 1), dtype=np.int64)  # record, parameter row, claim counter
+    # numba types a read-only array apart: it would compile the whole solver once more for one
+    if not ax.flags.writeable:
+        ax, ay = np.array(ax), (None if ay is ax else ay)
+        ay = ax if ay is None else ay
+    if not ay.flags.writeable:
+        ay = np.array(ay)
     run_cases(np.ascontiguousarray(p_vec).reshape(1, -1), ax, ay,
               np.array([0, ax.shape[0]], dtype=np.int64), np.array([float(dt)]),
               np.array([has_ay], dtype=np.bool_), ints[0], ints[1], np.array([float(sh)]),
