@@ -122,11 +122,10 @@ def write_busy_core(out, rows):
                   f"{'NOT met' if slower else 'met'})\n")
 
 
-#: Runs of the pipeline of :func:`dask_scaling` (``--quick``: ``QUICK_DASK_RUNS``), and its
-#: bootstrap resamples per fit.
-DASK_RUNS = 3000
-QUICK_DASK_RUNS = 600
-DASK_BOOTSTRAP = 500
+#: The pipelines of :func:`dask_scaling`: (name, runs, bootstrap resamples per fit), and their
+#: runs with ``--quick``. "runs" times the solver's part (no bootstrap), "fits" the bootstrap.
+DASK_CASES = (("runs", 30000, 0), ("fits", 3000, 500))
+QUICK_DASK_CASES = (("runs", 3000, 0), ("fits", 600, 500))
 
 
 def _same_results(a, b) -> bool:
@@ -152,26 +151,38 @@ def _warm_worker():
     return True
 
 
-def dask_scaling(n_workers=(1, 2), quick=False, directory=None):
-    """A pipeline locally and on Dask LocalClusters of ``n_workers`` one-core worker processes.
+def _timed_pipeline(path, output, client=None):
+    """Run a pipeline; ``(dataset, seconds, stage timings)``."""
+    from shipblock.fragility.pipeline import run_pipeline
 
-    The pipeline is the bench's campaign pipeline (:func:`shipblock.bench.write_campaign_pipeline`:
-    the six shipped records, IDA levels, a friction x slenderness sweep) of :data:`DASK_RUNS`
-    runs with :data:`DASK_BOOTSTRAP` bootstrap resamples per fit. It runs once here (numba
-    threads on all cores), then on each cluster: worker processes of one task thread and one
-    numba thread each (``NUMBA_NUM_THREADS=1``: one core per worker, as on a cluster node
-    shared out a core per worker), their solver loaded beforehand; the bootstrap resamples go to
-    the cluster (each fit's are estimated above
+    timings = {}
+    t0 = time.perf_counter()
+    ds = run_pipeline(path, output=output, client=client, progress=False, timings=timings)
+    return ds, time.perf_counter() - t0, timings
+
+
+def dask_scaling(n_workers=(1, 2), quick=False, directory=None):
+    """Pipelines here and on Dask LocalClusters of ``n_workers`` one-core worker processes.
+
+    Two pipelines (:data:`DASK_CASES`), both the bench's campaign pipeline
+    (:func:`shipblock.bench.write_campaign_pipeline`: the six shipped records, IDA levels, a
+    friction x slenderness sweep): "runs", 30,000 runs without bootstrap, for the solver's part;
+    "fits", 3,000 runs with 500 bootstrap resamples per fit, for the fits. Each runs once here
+    (the batch on all cores, the bootstrap here or on local processes), then on each cluster:
+    worker processes of one task thread and one numba thread each (``NUMBA_NUM_THREADS=1``: one
+    core per worker, as on a node shared out a core per worker), their solver loaded
+    beforehand; the bootstrap resamples go to the cluster (each fit's are estimated above
     :data:`~shipblock.fragility.workers.DASK_SECONDS`). Each result is compared with the local
     one bit for bit.
 
     Returns
     -------
     dict or None
-        ``runs``, ``local`` (``seconds``, ``runs_per_s``, ``stages``) and ``clusters``: per
-        number of workers ``seconds``, ``runs_per_s``, ``runs_per_s_per_worker``, ``stages``
-        (pipeline timings [s]: runs, fragility, ...), ``identical``; ``scaling`` (runs/s of the
-        largest cluster over the smallest's); None without ``distributed``.
+        Per pipeline name: ``runs``, ``bootstrap``, ``local`` (``seconds``, ``runs_per_s``,
+        ``stages``) and ``clusters``: per number of workers ``seconds``, ``runs_per_s``,
+        ``runs_per_s_per_worker``, ``stage_seconds`` (the pipeline's timings [s]: runs,
+        fragility, ...), ``identical``; and ``scaling`` (the largest cluster's wall time
+        against the smallest's). None without ``distributed``.
     """
     import tempfile
     from pathlib import Path
@@ -181,59 +192,64 @@ def dask_scaling(n_workers=(1, 2), quick=False, directory=None):
     except ImportError:
         return None
     from shipblock.bench import write_campaign_pipeline
-    from shipblock.fragility.pipeline import run_pipeline
 
-    n_runs = QUICK_DASK_RUNS if quick else DASK_RUNS
-    out = {"runs": None, "clusters": {}}
+    cases = QUICK_DASK_CASES if quick else DASK_CASES
+    out = {}
     with tempfile.TemporaryDirectory(prefix="shipblock-dask-") as tmp:
         work = Path(directory) if directory is not None else Path(tmp)
-        path, info = write_campaign_pipeline(work, n_runs)
-        text = path.read_text().replace("bootstrap = 0", f"bootstrap = {DASK_BOOTSTRAP}")
-        path.write_text(text)
-        out.update(grid=info)
-        timings = {}
-        t0 = time.perf_counter()
-        local = run_pipeline(path, output=work / "local.nc", progress=False, timings=timings)
-        seconds = time.perf_counter() - t0
-        runs = int(local["peak_rotation"].size)
-        out["runs"] = runs
-        out["local"] = {"seconds": seconds, "runs_per_s": runs / seconds, "stages": timings}
+        paths, locals_ = {}, {}
+        for name, n_runs, n_boot in cases:
+            path, _ = write_campaign_pipeline(work / name, n_runs)
+            path.write_text(path.read_text().replace("bootstrap = 0", f"bootstrap = {n_boot}"))
+            ds, seconds, stages = _timed_pipeline(path, work / name / "local.nc")
+            runs = int(ds["peak_rotation"].size)
+            paths[name], locals_[name] = path, ds
+            out[name] = {"runs": runs, "bootstrap": n_boot, "clusters": {},
+                         "local": {"seconds": seconds, "runs_per_s": runs / seconds,
+                                   "stages": stages}}
         for n in sorted(set(int(k) for k in n_workers)):
             with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                           dashboard_address=None,
                                           env={"NUMBA_NUM_THREADS": "1"}) as cluster, \
                     distributed.Client(cluster) as client:
                 client.run(_warm_worker)
-                timings = {}
-                t0 = time.perf_counter()
-                ds = run_pipeline(path, output=work / f"dask{n}.nc", client=client,
-                                  progress=False, timings=timings)
-                seconds = time.perf_counter() - t0
-            out["clusters"][n] = {"seconds": seconds, "runs_per_s": runs / seconds,
-                                  "runs_per_s_per_worker": runs / seconds / n, "stages": timings,
-                                  "identical": _same_results(local, ds)}
-    if len(out["clusters"]) > 1:
-        lo, hi = min(out["clusters"]), max(out["clusters"])
-        out["scaling"] = out["clusters"][hi]["runs_per_s"] / out["clusters"][lo]["runs_per_s"]
+                for name, _, _ in cases:
+                    ds, seconds, stages = _timed_pipeline(paths[name],
+                                                          work / name / f"dask{n}.nc", client)
+                    runs = out[name]["runs"]
+                    out[name]["clusters"][n] = {
+                        "seconds": seconds, "runs_per_s": runs / seconds,
+                        "runs_per_s_per_worker": runs / seconds / n, "stages": stages,
+                        "identical": _same_results(locals_[name], ds)}
+    for d in out.values():
+        if len(d["clusters"]) > 1:
+            lo, hi = min(d["clusters"]), max(d["clusters"])
+            d["scaling"] = d["clusters"][lo]["seconds"] / d["clusters"][hi]["seconds"]
     return out
 
 
-def write_dask_scaling(out, d):
+def write_dask_scaling(out, results):
     """Print the figures of :func:`dask_scaling`."""
-    if d is None:
+    if results is None:
         out.write("dask              : distributed not installed (pip install 'shipblock[dask]')\n")
         return
-    loc = d["local"]
-    out.write(f"dask              : pipeline of {d['runs']} runs, {DASK_BOOTSTRAP} bootstrap "
-              f"resamples per fit; here on all cores {loc['seconds']:.3g} s "
-              f"({loc['runs_per_s']:.3g} runs/s; runs {loc['stages'].get('runs', 0):.2g} s, fits "
-              f"{loc['stages'].get('fragility', 0):.2g} s)\n")
-    for n, c in sorted(d["clusters"].items()):
-        st = c["stages"]
-        out.write(f"{'':20}LocalCluster of {n} one-core worker(s): {c['seconds']:.3g} s, "
-                  f"{c['runs_per_s']:.3g} runs/s, {c['runs_per_s_per_worker']:.3g} per worker "
-                  f"(runs {st.get('runs', 0):.2g} s, fits {st.get('fragility', 0):.2g} s); results "
-                  f"{'identical to' if c['identical'] else 'DIFFERENT from'} the local run\n")
-    if "scaling" in d:
-        lo, hi = min(d["clusters"]), max(d["clusters"])
-        out.write(f"{'':20}scaling from {lo} to {hi} workers: {d['scaling']:.2f}x\n")
+    first = True
+    for name, d in results.items():
+        loc = d["local"]
+        stage = "runs" if d["bootstrap"] == 0 else "fragility"
+        what = ("solver part" if d["bootstrap"] == 0
+                else f"{d['bootstrap']} bootstrap resamples per fit")
+        out.write(f"{'dask' if first else '':<18}: pipeline '{name}' of {d['runs']} runs ({what});"
+                  f" here on all cores {loc['seconds']:.3g} s ({stage} "
+                  f"{loc['stages'].get(stage, 0):.3g} s)\n")
+        first = False
+        for n, c in sorted(d["clusters"].items()):
+            st = c["stages"]
+            out.write(f"{'':20}LocalCluster of {n} one-core worker(s): {c['seconds']:.3g} s, "
+                      f"{c['runs_per_s']:.3g} runs/s, {c['runs_per_s_per_worker']:.3g} per "
+                      f"worker ({stage} {st.get(stage, 0):.3g} s); results "
+                      f"{'identical to' if c['identical'] else 'DIFFERENT from'} the local "
+                      f"run\n")
+        if "scaling" in d:
+            lo, hi = min(d["clusters"]), max(d["clusters"])
+            out.write(f"{'':20}scaling from {lo} to {hi} workers: {d['scaling']:.2f}x\n")

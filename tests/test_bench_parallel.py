@@ -76,16 +76,16 @@ def test_cold_start_child_reports_what_compiled(tmp_path):
 
 
 def test_dask_report():
-    d = {"runs": 648, "local": {"seconds": 4.0, "runs_per_s": 162.0,
-                                "stages": {"runs": 0.5, "fragility": 2.0}},
-         "clusters": {1: {"seconds": 5.0, "runs_per_s": 129.6, "runs_per_s_per_worker": 129.6,
-                          "stages": {"runs": 1.0}, "identical": True},
-                      2: {"seconds": 3.0, "runs_per_s": 216.0, "runs_per_s_per_worker": 108.0,
-                          "stages": {"runs": 0.6}, "identical": False}},
-         "scaling": 216.0 / 129.6}
+    clusters = {1: {"seconds": 5.0, "runs_per_s": 600.0, "runs_per_s_per_worker": 600.0,
+                    "stages": {"runs": 4.0}, "identical": True},
+                2: {"seconds": 3.0, "runs_per_s": 1000.0, "runs_per_s_per_worker": 500.0,
+                    "stages": {"runs": 2.0}, "identical": False}}
+    d = {"runs": {"runs": 3000, "bootstrap": 0, "clusters": clusters, "scaling": 5.0 / 3.0,
+                  "local": {"seconds": 4.0, "runs_per_s": 750.0, "stages": {"runs": 2.5}}}}
     out = io.StringIO()
     bench_parallel.write_dask_scaling(out, d)
     text = out.getvalue()
+    assert "pipeline 'runs' of 3000 runs (solver part)" in text
     assert "identical to the local run" in text and "DIFFERENT from the local run" in text
     assert "scaling from 1 to 2 workers: 1.67x" in text
     out = io.StringIO()
