@@ -37,7 +37,7 @@ class UserError(Exception):
 
 #: What numba compiles on first use, by the module of the function compiled: (module prefix,
 #: what it is, seconds it took from an empty cache). The seconds are measured by
-#: ``shipblock bench`` (:func:`shipblock.bench.cold_start`, docs/benchmarks.rst "Cold start") on
+#: ``shipblock bench`` (:func:`shipblock.bench_startup.cold_start`, docs/benchmarks.rst) on
 #: the project's 2-core machine; the notice quotes them, and the log says afterwards how long it
 #: took here.
 COMPILED_PARTS = (
