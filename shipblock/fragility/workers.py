@@ -14,15 +14,13 @@ Two concerns of a study spread over cores or over a Dask cluster:
   (:func:`~shipblock.fragility.fit.bootstrap`) onto a Dask client when one is given, else onto
   a pool of local processes (forked on Linux) once the resamples run here would take long
   enough (:data:`LOCAL_POOL_SECONDS`, counting those of the fits before) to pay for starting
-  it, else runs them here. Each resample has
-  its own seed (``numpy.random.SeedSequence.spawn``), so the result does not depend on where or
-  in what blocks the resamples ran.
+  it, else runs them here. Each resample has its own seed (``numpy.random.SeedSequence.spawn``),
+  so the result does not depend on where or in what blocks the resamples ran.
 """
 
 from __future__ import annotations
 
 import sys
-import time
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -256,13 +254,6 @@ def blocks(n: int, slots: int) -> list[range]:
     return [range(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True) if b > a]
 
 
-def timed(fn: Callable, *args, **kwargs):
-    """``(fn(*args, **kwargs), seconds)``."""
-    t0 = time.perf_counter()
-    out = fn(*args, **kwargs)
-    return out, time.perf_counter() - t0
-
-
 __all__ = ["Workers", "blocks", "host_task_threads", "main_is_safe_to_spawn",
-           "numba_threads_per_task", "pool_context", "run_chunk_task", "timed",
+           "numba_threads_per_task", "pool_context", "run_chunk_task",
            "LOCAL_POOL_SECONDS", "SPAWN_POOL_SECONDS", "DASK_SECONDS", "PROBE_REPLICATES"]
