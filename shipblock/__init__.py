@@ -18,11 +18,14 @@ except PackageNotFoundError:  # running from a source tree that is not installed
 
 from shipblock.modes import EventKind, Failure, Mode
 from shipblock.result import Energy, Event, SimulationResult
-from shipblock.solver import RecordSet, simulate, simulate_batch
 from shipblock.system import ShipBlockSystem, system_restitution
 
-# Heavier parts load on first use (obspy, xarray, scipy.stats).
+# Heavier parts load on first use (numba and the solver, obspy, xarray, scipy.stats): a command
+# that does not simulate does not import the solver.
 _LAZY = {
+    "simulate": "shipblock.solver",
+    "simulate_batch": "shipblock.solver",
+    "RecordSet": "shipblock.solver",
     "read_motion": "shipblock.motion",
     "GroundMotion": "shipblock.motion",
     "COMPONENT_KEY": "shipblock.motion",

@@ -9,7 +9,13 @@ documentation's benchmark page quotes a run of this command.
 * speed-up of :func:`~shipblock.simulate_batch` from one core to all;
 * time per record against pySLAMMER (:func:`pyslammer_comparison`);
 * a campaign of a generated pipeline through :func:`~shipblock.fragility.pipeline.run_pipeline`
-  in a subprocess: wall time, stages and memory (:func:`campaign`).
+  in a subprocess: wall time, stages and memory (:func:`campaign`);
+* a batch on one thread and on all, beside a busy process
+  (:func:`shipblock.bench_parallel.busy_core_batch`);
+* the README's demo command from an empty numba cache
+  (:func:`shipblock.bench_startup.cold_start`);
+* with ``--dask``, a pipeline on LocalClusters of 1 and 2 workers
+  (:func:`shipblock.bench_parallel.dask_scaling`).
 """
 
 from __future__ import annotations
@@ -437,7 +443,7 @@ def _mb(n):
 
 
 def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campaign_runs=None,
-                   chunk_size=None, profile=None):
+                   chunk_size=None, profile=None, cold=True, dask_workers=None):
     """Run all benchmarks and print a report.
 
     Parameters
@@ -457,6 +463,12 @@ def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campai
         Cases per chunk of the campaign (default: about 100 chunks).
     profile : str or os.PathLike, optional
         Profile the campaign with :mod:`cProfile` and write the statistics to this file.
+    cold : bool
+        Include the cold start (:func:`shipblock.bench_startup.cold_start`: the demo command
+        from an empty numba cache, in subprocesses).
+    dask_workers : sequence of int, optional
+        Also run :func:`shipblock.bench_parallel.dask_scaling` on LocalClusters of these numbers
+        of worker processes.
 
     Returns
     -------
@@ -520,6 +532,11 @@ def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campai
               f"{scaling['machine_speedup']:.3f}x (best calls of {scaling['rounds']} rounds; "
               f"median of the rounds' ratios: batch {scaling['speedup_median']:.2f}x, "
               f"loop {scaling['machine_speedup_median']:.2f}x)\n")
+    from shipblock.bench_parallel import busy_core_batch, write_busy_core
+
+    busy = busy_core_batch(min_seconds=1.0 if quick else 3.0, copies=(1,) if quick else (1, 10))
+    results["busy_core"] = busy
+    write_busy_core(out, busy)
     if pyslammer:
         ps = pyslammer_comparison()
         if ps is None:
@@ -545,6 +562,18 @@ def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campai
                       f"{ps['pyslammer_s_per_record'] / ps['simulate_s_per_record']:.2g}x "
                       f"(per record: median {np.median(sp):.2g}x, min {sp.min():.2g}x, "
                       f"max {sp.max():.2g}x)\n")
+    if cold:
+        from shipblock.bench_startup import cold_start, write_cold_start
+
+        out.flush()
+        results["cold_start"] = cold_start()
+        write_cold_start(out, results["cold_start"])
+    if dask_workers:
+        from shipblock.bench_parallel import dask_scaling, write_dask_scaling
+
+        out.flush()
+        results["dask"] = dask_scaling(dask_workers, quick=quick)
+        write_dask_scaling(out, results["dask"])
     if campaign_runs:
         out.flush()
         c = campaign(campaign_runs, chunk_size=chunk_size, profile=profile)

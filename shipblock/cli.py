@@ -35,34 +35,81 @@ class UserError(Exception):
     """An error caused by the user's input: reported in one line, no traceback."""
 
 
-#: Said once when a command starts compiling (numba's cache empty: a fresh install or new numba).
-COMPILE_NOTICE = ("compiling shipblock's solver for this machine: a minute or two the first time, "
-                  "kept in numba's cache for later runs")
+#: What numba compiles on first use, by the module of the function compiled: (module prefix,
+#: what it is, seconds it took from an empty cache). The seconds are measured by
+#: ``shipblock bench`` (:func:`shipblock.bench_startup.cold_start`, docs/benchmarks.rst) on
+#: the project's 2-core machine; the notice quotes them, and the log says afterwards how long it
+#: took here.
+COMPILED_PARTS = (
+    ("shipblock.solver", "the solver", 17.0),
+    ("shipblock.equations", "the solver", 17.0),
+    ("shipblock.impact", "the solver", 17.0),
+    ("shipblock.intensity", "the intensity measures", 0.3),
+)
+
+
+def compiled_part(module: str) -> tuple[str, float | None]:
+    """What a compiled function of ``module`` belongs to, and its measured compile time [s]."""
+    for prefix, what, seconds in COMPILED_PARTS:
+        if module == prefix or module.startswith(prefix + "."):
+            return what, seconds
+    return f"numba code of {module}", None
+
+
+def compile_message(what: str, seconds: float | None) -> str:
+    """The notice said when ``what`` starts compiling."""
+    took = "" if seconds is None else f": about {seconds:.2g} s on 2 cores"
+    return (f"compiling {what} for this machine (first use only, kept in numba's cache for later "
+            f"runs){took}")
 
 
 @contextmanager
-def compile_notice(say):
-    """Call ``say()`` once if numba compiles anything within the block.
+def compile_notice(say, done=None):
+    """Call ``say(message)`` once per part when numba compiles it within the block.
 
     Loading a function from numba's on-disk cache is not a compilation, so ``say`` runs only
-    on a first use, where a progress bar would otherwise sit at 0 % for a minute or two with no
-    word of why. Uses numba's event API (``numba:compile`` is triggered on a cache miss only).
+    on a first use, where a progress bar would otherwise sit at 0 % with no word of why. The
+    message names the part compiled (the solver, the intensity measures; :func:`compiled_part`)
+    and the time it took on the benchmark machine. ``done(what, seconds)``, if given, is called
+    when a part has compiled, with the time it took here [s]. Uses numba's event API
+    (``numba:compile`` is triggered on a cache miss only; the outermost of nested events
+    is the function a command called).
     """
+    import time
+
     from numba.core import event
 
-    class _Once(event.Listener):
-        said = False
+    class _Parts(event.Listener):
+        def __init__(self):
+            self.said = set()
+            self.depth = 0
+            self.what = None
+            self.t0 = 0.0
 
         def on_start(self, ev):
-            if not self.said:
-                self.said = True
-                say()
+            self.depth += 1
+            if self.depth > 1:
+                return
+            dispatcher = (ev.data or {}).get("dispatcher")
+            module = getattr(getattr(dispatcher, "py_func", None), "__module__", None) or "?"
+            what, seconds = compiled_part(module)
+            self.what, self.t0 = what, time.perf_counter()
+            if what not in self.said:
+                self.said.add(what)
+                say(compile_message(what, seconds))
 
         def on_end(self, ev):
-            pass
+            self.depth -= 1
+            if self.depth == 0 and done is not None:
+                done(self.what, time.perf_counter() - self.t0)
 
-    with event.install_listener("numba:compile", _Once()):
+    with event.install_listener("numba:compile", _Parts()):
         yield
+
+
+def _log_compiled(what, seconds):
+    if seconds >= 1.0:
+        log.info("%s compiled in %.1f s", what, seconds)
 
 
 # --------------------------------------------------------------------------- record input
@@ -518,9 +565,18 @@ def cmd_bench(args):
         raise UserError(f"--campaign-runs must be >= 0, got {args.campaign_runs}")
     if args.chunk_size is not None and args.chunk_size < 1:
         raise UserError(f"--chunk-size must be >= 1, got {args.chunk_size}")
+    dask_workers = None
+    if args.dask:
+        try:
+            dask_workers = [int(n) for n in args.dask.split(",")]
+        except ValueError:
+            raise UserError(f"--dask takes numbers of workers like 1,2; got {args.dask!r}") from None
+        if min(dask_workers) < 1:
+            raise UserError(f"--dask: numbers of workers must be >= 1, got {args.dask!r}")
     return run_benchmarks(quick=args.quick, pyslammer=not args.no_pyslammer, output=args.output,
                           campaign_runs=args.campaign_runs, chunk_size=args.chunk_size,
-                          profile=args.profile)
+                          profile=args.profile, cold=not args.no_cold_start,
+                          dask_workers=dask_workers)
 
 
 # --------------------------------------------------------------------------- parser
@@ -626,6 +682,12 @@ def build_parser():
                    help="cases per chunk of the campaign (default: about 100 chunks)")
     s.add_argument("--profile", metavar="FILE",
                    help="profile the campaign with cProfile and write the statistics to FILE")
+    s.add_argument("--no-cold-start", action="store_true",
+                   help="skip the cold start (the demo command from an empty numba cache)")
+    s.add_argument("--dask", metavar="N[,N...]",
+                   help="also run a pipeline on Dask LocalClusters of these numbers of worker "
+                        "processes (e.g. 1,2): runs/s per worker, scaling, equality with the "
+                        "local run")
     s.add_argument("--read", nargs="+", metavar="SOURCE",
                    help="only the readers' benchmark: files/s per format on these folders, globs"
                         " or files")
@@ -647,7 +709,7 @@ def main(argv=None):
         from tqdm.contrib.logging import logging_redirect_tqdm
 
         # log lines go above a progress bar, not onto its line
-        with logging_redirect_tqdm(), compile_notice(lambda: log.info(COMPILE_NOTICE)):
+        with logging_redirect_tqdm(), compile_notice(log.info, _log_compiled):
             return args.func(args)
     except (UserError, ShipblockError, ValueError, FileNotFoundError, OSError) as exc:
         if args.verbose > 1:

@@ -254,9 +254,11 @@ def test_compile_notice_speaks_once_and_only_when_numba_compiles():
     def thrice(x):
         return 3.0 * twice(x) / 2.0
 
-    with compile_notice(lambda: said.append(1)):
+    done = []
+    with compile_notice(said.append, lambda what, seconds: done.append((what, seconds))):
         assert thrice(1.0) == 3.0  # compiles both
-    assert said == [1]
-    with compile_notice(lambda: said.append(2)):
+    assert len(said) == 1 and said[0].startswith(f"compiling numba code of {__name__}")
+    assert len(done) == 1 and done[0][0] == f"numba code of {__name__}" and done[0][1] > 0.0
+    with compile_notice(said.append):
         assert thrice(2.0) == 6.0  # already compiled
-    assert said == [1]
+    assert len(said) == 1

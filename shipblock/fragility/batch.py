@@ -415,8 +415,16 @@ def run_batch(
 
 
 def _run_dask(client, records, systems, tasks, runnable, opts, finish):
-    """Submit the runnable chunks as Dask tasks and finish them as they complete."""
+    """Submit the runnable chunks as Dask tasks and finish them as they complete.
+
+    Each task runs on its share of its host's cores (numba threads:
+    :func:`~shipblock.fragility.workers.run_chunk_task`).
+    """
     from distributed import as_completed
+
+    from shipblock.fragility.workers import host_task_threads, run_chunk_task
+
+    hosts = host_task_threads(client)
 
     needed = sorted({int(r) for k in runnable for r in tasks[k].records})
     scattered = {r: client.scatter(records[r].payload(), hash=False) for r in needed}
@@ -424,8 +432,8 @@ def _run_dask(client, records, systems, tasks, runnable, opts, finish):
     futures = {}
     for k in runnable:
         t = tasks[k]
-        fut = client.submit(run_chunk, [scattered[int(r)] for r in t.records], sys_future,
-                            t.local_cases, pure=False, **opts)
+        fut = client.submit(run_chunk_task, [scattered[int(r)] for r in t.records], sys_future,
+                            t.local_cases, hosts, pure=False, **opts)
         futures[fut] = k
     try:
         for fut in as_completed(futures):

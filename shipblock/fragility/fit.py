@@ -46,6 +46,7 @@ References
 
 from __future__ import annotations
 
+import time
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
@@ -1162,14 +1163,18 @@ def bootstrap(
     im=None,
     n_boot: int = 1000,
     confidence: float = 0.9,
-    seed: int | np.random.Generator | None = None,
+    seed: int | np.random.Generator | np.random.SeedSequence | None = None,
+    workers=None,
     **fit_kwargs,
 ) -> BootstrapResult:
     """Bootstrap confidence bands of a fragility fit by resampling records with replacement.
 
     Each replicate draws ``n_records`` record indices with replacement, takes those rows
     (axis 0) of every array in ``records``, and refits with
-    ``fit_function(**resampled_records, **fit_kwargs)``. The band is the pointwise
+    ``fit_function(**resampled_records, **fit_kwargs)``. Replicate ``k`` draws from its own
+    generator, seeded with the ``k``-th child of the seed's :class:`numpy.random.SeedSequence`
+    (``SeedSequence.spawn``), so the replicates can be spread over processes or a Dask cluster
+    (``workers``) in any blocks with the same result. The band is the pointwise
     ``(1 - confidence)/2`` and ``(1 + confidence)/2`` percentiles of the refitted curves;
     ``median_ci`` and ``beta_ci`` are the same percentiles of the refitted parameters (Efron &
     Tibshirani 1993 [1]_, percentile method).
@@ -1191,8 +1196,14 @@ def bootstrap(
         Number of bootstrap replicates [-].
     confidence : float
         Confidence level of the bands, in (0, 1) [-].
-    seed : int or numpy.random.Generator, optional
-        Seed or generator for the resampling; no global random state is used.
+    seed : int, numpy.random.Generator or numpy.random.SeedSequence, optional
+        Seed of the resampling (a generator's own seed sequence is spawned from); no global
+        random state is used.
+    workers : shipblock.fragility.workers.Workers, optional
+        Where the replicates run, in blocks: a Dask client, local processes, or here (default),
+        depending on the time the others are estimated to take here, from the time of the first
+        ``PROBE_REPLICATES`` (run here). ``fit_function`` and the arrays must then be picklable (the fits of
+        this module are).
     **fit_kwargs
         Arguments that are not resampled (``im_levels=...``, ``capacity=...``, ...).
 
@@ -1228,7 +1239,7 @@ def bootstrap(
         raise ParameterError(f"all record arrays need the same length along axis 0, got {lengths}")
     (n_rec,) = n_rec
     try:
-        rng = np.random.default_rng(seed)
+        seeds = _replicate_seeds(seed, int(n_boot))
     except (TypeError, ValueError) as exc:
         raise ParameterTypeError(f"seed must be None, a non-negative integer (or sequence of "
                                  f"them) or a numpy Generator, got {seed!r} ({exc})") from None
@@ -1239,19 +1250,24 @@ def bootstrap(
         if im is None
         else np.asarray(im, dtype=float)
     )
-    medians, betas = [], []
-    n_failed = 0
-    for _ in range(int(n_boot)):
-        idx = rng.integers(0, n_rec, size=n_rec)
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)
-                f = fit_function(**{k: a[idx] for k, a in arrays.items()}, **fit_kwargs)
-        except FragilityFitError:
-            n_failed += 1
-            continue
-        medians.append(f.median)
-        betas.append(f.beta)
+    if workers is None:
+        parts = [_bootstrap_block(fit_function, arrays, fit_kwargs, seeds)]
+    else:
+        from shipblock.fragility.workers import PROBE_REPLICATES, blocks
+
+        # the first replicates here, timed: the estimate of where the others should go
+        t0 = time.perf_counter()
+        parts = [_bootstrap_block(fit_function, arrays, fit_kwargs, seeds[:PROBE_REPLICATES])]
+        rest = seeds[PROBE_REPLICATES:]
+        if rest:
+            estimate = (time.perf_counter() - t0) / PROBE_REPLICATES * len(rest)
+            items = [(fit_function, arrays, fit_kwargs, rest[b.start:b.stop])
+                     for b in blocks(len(rest), workers.slots())]
+            parts += workers.map(_bootstrap_block, items, estimated_seconds=estimate)
+    fitted = np.concatenate(parts, axis=1) if parts else np.zeros((2, 0))
+    ok = np.isfinite(fitted[0])
+    medians, betas = fitted[0, ok].tolist(), fitted[1, ok].tolist()
+    n_failed = int(np.count_nonzero(~ok))
     if len(medians) < max(2, n_boot / 2):
         raise ParameterError(
             f"only {len(medians)} of {n_boot} bootstrap refits succeeded; the data are too "
@@ -1282,3 +1298,34 @@ def bootstrap(
         betas=betas,
         n_failed=n_failed,
     )
+
+
+def _replicate_seeds(seed, n_boot: int) -> list:
+    """One :class:`numpy.random.SeedSequence` per bootstrap replicate, spawned from ``seed``."""
+    if isinstance(seed, np.random.Generator):
+        sequence = seed.bit_generator.seed_seq
+    elif isinstance(seed, np.random.SeedSequence):
+        sequence = seed
+    else:
+        sequence = np.random.SeedSequence(seed)
+    return sequence.spawn(n_boot)
+
+
+def _bootstrap_block(fit_function, arrays, fit_kwargs, seeds) -> np.ndarray:
+    """Medians and betas of the replicates with these seeds: shape (2, len(seeds)), NaN if unfittable.
+
+    A pure function of its arguments (a task for local processes or Dask): replicate ``k``
+    resamples the records with ``numpy.random.default_rng(seeds[k])``.
+    """
+    n_rec = next(iter(arrays.values())).shape[0]
+    out = np.full((2, len(seeds)), np.nan)
+    for k, child in enumerate(seeds):
+        idx = np.random.default_rng(child).integers(0, n_rec, size=n_rec)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                f = fit_function(**{name: a[idx] for name, a in arrays.items()}, **fit_kwargs)
+        except FragilityFitError:
+            continue
+        out[0, k], out[1, k] = f.median, f.beta
+    return out

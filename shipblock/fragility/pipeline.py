@@ -166,6 +166,7 @@ from shipblock.fragility.store import (
     remove_stale_temporaries,
     write_dataset,
 )
+from shipblock.fragility.workers import Workers
 from shipblock.solver import DEFAULT_ATOL, DEFAULT_RTOL, DEFAULT_ZENO_OMEGA
 from shipblock.solver._inputs import check_options
 from shipblock.system import ShipBlockSystem
@@ -1058,7 +1059,7 @@ def _check_chain(chain, source):
 # --------------------------------------------------------------------------------------------
 
 
-def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng):
+def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng, workers=None):
     """Fit one limit state for one parameter combination; returns a dict of results."""
     out = {"median": np.nan, "beta": np.nan, "median_lower": np.nan, "median_upper": np.nan,
            "beta_lower": np.nan, "beta_upper": np.nan, "fit_method": "", "fit_error": "",
@@ -1092,7 +1093,7 @@ def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng):
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", RuntimeWarning)
                     b = bootstrap(fn, args, n_boot=n_boot, confidence=fit_opts["confidence"],
-                                  seed=rng, **kw)
+                                  seed=rng, workers=workers, **kw)
                 out.update(median_lower=b.fit.median_ci[0], median_upper=b.fit.median_ci[1],
                            beta_lower=b.fit.beta_ci[0], beta_upper=b.fit.beta_ci[1],
                            bootstrap_failed=b.n_failed)
@@ -1172,7 +1173,7 @@ class _FitCheckpoint:
 
 def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fit_opts,
                         store: ChunkStore | None = None,
-                        im_display: tuple[str, float] = ("", 1.0)) -> dict:
+                        im_display: tuple[str, float] = ("", 1.0), workers=None) -> dict:
     """Exceedance, fitted median/beta and bootstrap bounds of every limit state.
 
     Parameters
@@ -1196,6 +1197,8 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
         fits are made in it, so that their messages (``fit_error``) quote the levels as the
         pipeline wrote them, and with ``"g"`` the medians are stored in g too (``median_g``,
         ``median_lower_g``, ``median_upper_g``). Default: SI.
+    workers : shipblock.fragility.workers.Workers, optional
+        Where the bootstrap resamples run (see :func:`~shipblock.fragility.fit.bootstrap`).
 
     Returns
     -------
@@ -1246,7 +1249,7 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
                 sel = (slice(None),) * lead + combo
                 rng = np.random.default_rng([int(fit_opts["seed"]), i, c])
                 res, caps = _fit_one(kind, e_all[sel], w_all[sel], levels, im, edp_all[sel],
-                                     ls, fit_opts, rng)
+                                     ls, fit_opts, rng, workers)
                 for k in ("median", "median_lower", "median_upper"):
                     res[k] *= factor  # back to SI
                 if res["fit_error"]:
@@ -1599,15 +1602,17 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         results = run_batch(design, records, store, chunk_size=pipe.chunk_size, client=client,
                             progress=progress, solver_options=pipe.solver, timings=timings,
                             runs=design.stripe_mask() & ~refused)
+        clock.lap("runs")
+        ds = summary_dataset(design, records, results)
+        ds = ds.assign_coords({k: xr.Variable(*v) for k, v in _limit_state_coords(
+            pipe.limit_states).items()})
+        # the bootstrap resamples on the client's workers too, or on local processes
+        with Workers(client) as workers:
+            ds = ds.assign(fragility_variables(ds, design, pipe.limit_states, pipe.fit, store,
+                                               im_display=pipe.im_display, workers=workers))
     finally:
         if own_client is not None:
             own_client.close()
-    clock.lap("runs")
-    ds = summary_dataset(design, records, results)
-    ds = ds.assign_coords({k: xr.Variable(*v) for k, v in _limit_state_coords(
-        pipe.limit_states).items()})
-    ds = ds.assign(fragility_variables(ds, design, pipe.limit_states, pipe.fit, store,
-                                       im_display=pipe.im_display))
     if pipe.im_display[0] == "g" and design.intensity.scaled:
         ds = ds.assign_coords(im_level_g=("im_level", ds["im_level"].values / STANDARD_GRAVITY, {
             "units": "g", "long_name": ds["im_level"].attrs["long_name"] + " in g"}))

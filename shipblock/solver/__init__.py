@@ -23,6 +23,7 @@ from shipblock.solver._inputs import (
     check_initial_state,
     check_options,
 )
+from shipblock.solver._threads import batch_threads, run_on_threads
 from shipblock.system import P_THC, ShipBlockSystem
 
 #: Default relative tolerance of the rocking integration [-].
@@ -321,6 +322,13 @@ def simulate_batch(
     so cases of very different cost (early failure, long rocking) keep all threads busy.
     Results do not depend on the number of threads or on the order of the cases.
 
+    The threads are at most :func:`numba.get_num_threads` (set it with
+    :func:`numba.set_num_threads`), one per case and one per CPU this process may run on; a
+    batch of under a millisecond of work runs on one thread, and a short batch (under about
+    20 ms of work per thread) leaves the cores other programs keep busy to them, so that it
+    never runs slower on all threads than on one
+    (:func:`shipblock.solver._threads.batch_threads`).
+
     Parameters
     ----------
     systems : ShipBlockSystem or sequence of ShipBlockSystem
@@ -384,24 +392,11 @@ def simulate_batch(
         return {name: np.zeros(0) for name in (*SUMMARY_FIELDS, *MODE_TIME_FIELDS,
                                                 "peak_rotation_ratio")}
     summaries = np.empty((rec_idx.size, K.N_SUMMARY))
-    K.run_many(
-        params,
-        packed.acc_h,
-        packed.acc_v,
-        packed.offsets,
-        packed.dts,
-        packed.has_v,
-        rec_idx,
-        par_idx,
-        scale_h,
-        scale_v,
-        rtol,
-        atol,
-        zeno_omega,
-        numba.get_num_threads(),
-        np.zeros(1, dtype=np.int64),
-        summaries,
-    )
+    args = (params, packed.acc_h, packed.acc_v, packed.offsets, packed.dts, packed.has_v, rec_idx,
+            par_idx, scale_h, scale_v, rtol, atol, zeno_omega, np.zeros(1, dtype=np.int64), summaries,
+            False, *K.no_histories(), np.zeros(6))
+    n_samples = float(np.diff(packed.offsets)[rec_idx].sum()) if rec_idx.size else 0.0
+    run_on_threads(K.run_cases, args, batch_threads(numba.get_num_threads(), rec_idx.size, n_samples))
     # one field per row, each row contiguous: the arrays returned are views of one block
     by_field = np.ascontiguousarray(summaries.T)
     out = {name: by_field[i] for name, i in SUMMARY_FIELDS.items()}

@@ -27,13 +27,14 @@ for the general kernel to apply.
 The functions called once per span or per event are compiled without numba's reference
 counting (``_nrt=False``; they neither allocate nor return arrays): it would otherwise update
 the counts of all their array arguments on every call, atomically, and the record and output
-arrays are shared by the runs that ``run_many`` executes in parallel.
+arrays are shared by the runs that ``run_cases`` executes on several threads.
 """
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from shipblock.equations import (
@@ -97,7 +98,7 @@ REST_FIRST = 32
 FAST_BLOCK = 64
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, forceinline=False, error_model="numpy")
 def linear_root(l0, l1, h):
     """Time in [0, h] at which a linear function going from ``l0`` to ``l1`` turns negative.
 
@@ -110,7 +111,7 @@ def linear_root(l0, l1, h):
     return h * l0 / (l0 - l1)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, forceinline=False, error_model="numpy")
 def min_linear_root(la0, la1, lb0, lb1, h):
     """As :func:`linear_root` for ``min(la, lb)`` of two linear functions (e.g. mu N - |T|).
 
@@ -124,7 +125,7 @@ def min_linear_root(la0, la1, lb0, lb1, h):
     return min(linear_root(la0, la1, h), linear_root(lb0, lb1, h))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, forceinline=False, error_model="numpy")
 def quadratic_root(q0, d0, c, h):
     """First time in [0, h] at which ``q(s) = q0 + d0 s + c s^2`` crosses below zero.
 
@@ -159,7 +160,7 @@ def quadratic_root(q0, d0, c, h):
     return best
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", forceinline=True)
 def slip_may_stop(sig, v0, u0, u1, h):
     """Whether a slip velocity, quadratic over the interval, may reach zero inside it.
 
@@ -181,7 +182,7 @@ def slip_may_stop(sig, v0, u0, u1, h):
     return sig * v0 + h * (d0 + c * h) < 0.0 or (d0 < 0.0 and d0 + 2.0 * c * h > 0.0)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", forceinline=True)
 def exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M):
     """Advance ``y`` by ``h`` with slip accelerations, ground acceleration and friction forces
     linear in time from their values at 0 (``*0``) to those at ``h`` (``*1``).
@@ -210,7 +211,7 @@ def exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M
     y[Y_DIS] += h * (d0 + 4.0 * dm + d1) / 6.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", forceinline=True)
 def exact_update_one(y, ix, iv, h, u0, u1, a0, a1, f0, f1, m):
     """As :func:`exact_update` when only one interface moves: slip ``y[ix]``, slip velocity
     ``y[iv]``, its acceleration ``u``, friction force ``f`` and the mass ``m`` it carries.
@@ -234,7 +235,7 @@ def exact_update_one(y, ix, iv, h, u0, u1, a0, a1, f0, f1, m):
     y[Y_DIS] += h * (d0 + 4.0 * dm + d1) / 6.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", forceinline=True)
 def held_fails_at(slip1, slip2, a1, G1, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1,
                   mus2, B, H):
     """Whether the conditions a non-rocking mode holds fail, at scaled ground input ``a1``,
@@ -253,7 +254,7 @@ def held_fails_at(slip1, slip2, a1, G1, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a
             | ((slip1 == 0) & (mus1 * fy1 < abs(fx1))) | ((slip2 == 0) & (mus2 * Fy1 < abs(Fx1))))
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", forceinline=True)
 def rest_breaks(ax_j, ay_j, has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g,
                 mus1, mus2, B, H):
     """Whether rest (mode 1, every event armed) fails the screen of :func:`nonrocking_span` at
@@ -262,11 +263,12 @@ def rest_breaks(ax_j, ay_j, has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, 
     At rest nothing moves, so the screen is :func:`held_fails_at` of the input at the end
     sample alone.
     """
-    return held_fails_at(0, 0, sh * ax_j, grav + (sv * ay_j if has_ay else 0.0), fx_a, fx_g,
-                         fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
+    return held_fails_at(np.int64(0), np.int64(0), sh * ax_j,
+                         grav + (sv * ay_j if has_ay else 0.0), fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g,
+                         Fy_a, Fy_g, mus1, mus2, B, H)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, forceinline=False, error_model="numpy")
 def held_interval(slip1, slip2, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2,
                   B, H):
     """Horizontal accelerations ``[lo, hi]`` at which the held conditions of a non-rocking mode
@@ -326,7 +328,7 @@ def held_interval(slip1, slip2, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, 
     return lo, hi
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, forceinline=False, error_model="numpy")
 def add_repeated(t, dt, n):
     """``t`` with ``dt > 0`` added ``n`` times, rounded after each addition: the same value as
     the loop of ``n`` additions, in a few operations per power of two passed.
@@ -363,7 +365,7 @@ def add_repeated(t, dt, n):
     return t
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, forceinline=False, error_model="numpy", _nrt=False)
 def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g,
               Fy_a, Fy_g, mus1, mus2, B, H, lo, hi):
     """Advance rest from sample ``k`` to the first interval that fails the screen (see
@@ -431,7 +433,7 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
     return k, add_repeated(time, dt, k - k0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def response_slot(slip1, sig1, slip2, sig2):
     """Row of the response cache of a non-rocking mode: 3 ground x 3 ship interface states.
 
@@ -444,7 +446,7 @@ def response_slot(slip1, sig1, slip2, sig2):
 
 
 # inlined: mode selection calls it for every non-rocking candidate
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def mode_response_start(p, work, slip1, sig1, slip2, sig2):
     """Where the response vectors of a non-rocking mode lie in the run's work array, solved on
     first use.
@@ -479,8 +481,9 @@ def mode_response_start(p, work, slip1, sig1, slip2, sig2):
     if work[W_RESP_STATE + slot] == 0.0:
         wa = work[start:start + N_SOLVE_OUT]
         wg = work[start + N_SOLVE_OUT:start + 2 * N_SOLVE_OUT]
-        ok_a = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
-        ok_g = solve_mode(p, slip1, 0, slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)
+        # (np.int64, not the literal 0: numba would compile solve_mode once more for a literal)
+        ok_a = solve_mode(p, slip1, np.int64(0), slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
+        ok_g = solve_mode(p, slip1, np.int64(0), slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)
         work[W_RESP_STATE + slot] = 1.0 if ok_a and ok_g else 2.0
         if ok_a and ok_g:
             work[W_HELD + 2 * slot], work[W_HELD + 2 * slot + 1] = held_interval(
@@ -491,7 +494,7 @@ def mode_response_start(p, work, slip1, sig1, slip2, sig2):
 
 # inlined into the kernel's loop: a call passed some 75 machine words of arguments at every
 # event, a few per cent of a stick-slip record's time
-@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@njit(cache=True, error_model="numpy", _nrt=False, forceinline=True)
 def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs,
                     store, hist, modes, work):
     """Advance a non-rocking mode sample by sample until an event or the end of the record.
@@ -665,9 +668,10 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         moving_s = slip2 or vs0 != 0.0
         if moving_b or moving_s:
             if not moving_s:
-                exact_update_one(y, Y_XB, Y_VB, h, ub0, ub1, a0, a1, fx0, fx1, mass_b)
+                exact_update_one(y, np.int64(Y_XB), np.int64(Y_VB), h, ub0, ub1, a0, a1, fx0, fx1,
+                                 mass_b)
             elif not moving_b:
-                exact_update_one(y, Y_XS, Y_VS, h, us0, us1, a0, a1, Fx0, Fx1, M)
+                exact_update_one(y, np.int64(Y_XS), np.int64(Y_VS), h, us0, us1, a0, a1, Fx0, Fx1, M)
             else:
                 exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M)
             axb = abs(y[Y_XB])
@@ -691,14 +695,14 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
     return k, tau, -1, time_in_mode, peak_xb, peak_xs
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, forceinline=False, error_model="numpy", _nrt=False)
 def _store_rest(p, y, hist, modes, k0, k1, mode):
     """History columns ``k0:k1`` of a rest phase: the same column repeated, row by row.
 
     Filling each row over the whole range (contiguous, vectorised) rather than column by
     column makes storing a skipped rest block about as cheap as skipping it.
     """
-    kin = kinetic_energy(p, 0.0, 1.0, 0, y[Y_VB], 0.0, y[Y_VS])
+    kin = kinetic_energy(p, 0.0, 1.0, np.int64(0), y[Y_VB], 0.0, y[Y_VS])
     for i in range(N_STATE):
         v = y[i]
         for j in range(k0, k1):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from shipblock.solver._layout import (
@@ -36,7 +37,7 @@ from shipblock.solver._layout import (
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R, P_THC
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def rearm(armed, g):
     """Re-arm the disarmed events whose function ``g`` is clear of zero: True if all are armed.
 
@@ -51,7 +52,7 @@ def rearm(armed, g):
     return all_armed
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def rotation_event(p, ms, e, theta):
     """The event functions that depend on the rotation alone: impact and overturning."""
     if e == EV_IMPACT:
@@ -59,7 +60,7 @@ def rotation_event(p, ms, e, theta):
     return p[P_THC] - ms[MS_S] * theta
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def event_functions(p, ms, y, fx, fy, Fx, Fy, g):
     """Fill ``g`` with the event functions of mode ``ms`` at state ``y`` and interface forces.
 
@@ -75,8 +76,8 @@ def event_functions(p, ms, y, fx, fy, Fx, Fy, g):
     else:
         g[EV_G_STICK] = (p[P_MUS1] * fy - abs(fx)) / weight
     if ms[MS_ROCK]:
-        g[EV_IMPACT] = rotation_event(p, ms, EV_IMPACT, y[Y_TH])
-        g[EV_OVERTURN] = rotation_event(p, ms, EV_OVERTURN, y[Y_TH])
+        g[EV_IMPACT] = rotation_event(p, ms, np.int64(EV_IMPACT), y[Y_TH])
+        g[EV_OVERTURN] = rotation_event(p, ms, np.int64(EV_OVERTURN), y[Y_TH])
     else:
         g[EV_UPLIFT] = (p[P_B] * (fy + Fy) - p[P_H] * abs(fx + Fx)) / (weight * p[P_R])
     if ms[MS_SLIP2]:
@@ -87,7 +88,7 @@ def event_functions(p, ms, y, fx, fy, Fx, Fy, g):
     g[EV_SEP_S] = Fy / ship_weight
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def impact_return_time(s, theta, omega, alpha):
     """Longest first step after an impact [s]: the rotation's return to zero at its start rates.
 
@@ -105,7 +106,7 @@ def impact_return_time(s, theta, omega, alpha):
     return math.inf
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def stuck_rocking_clear(p, s, theta, fx, fy, Fx, Fy):
     """Whether every event function of mode 3 (rocking, no interface slipping) is >= 0.
 

@@ -8,7 +8,7 @@ from shipblock.equations import kinetic_energy, potential_energy
 from shipblock.solver._layout import H_KIN, H_POT, MS_ROCK, MS_S, N_STATE, Y_OM, Y_TH, Y_VB, Y_VS
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def store_sample(p, ms, y, hist, modes, k, mode):
     """Write the state, kinetic and potential energy and mode number ``mode`` of sample ``k``.
 

@@ -26,12 +26,13 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from shipblock.solver._fused import fma
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def quintic_hermite(th0, om0, al0, th1, om1, al1, h):
     """Monomial coefficients ``(c0, ..., c5)`` of the quintic Hermite interpolant on u in [0, 1]."""
     d = th1 - th0
@@ -42,19 +43,19 @@ def quintic_hermite(th0, om0, al0, th1, om1, al1, h):
     return th0, h * om0, 0.5 * h2 * al0, c3, c4, c5
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def poly5(c0, c1, c2, c3, c4, c5, u):
     """Value of the quintic at ``u`` (Horner)."""
     return c0 + u * (c1 + u * (c2 + u * (c3 + u * (c4 + u * c5))))
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def poly5_slope(c1, c2, c3, c4, c5, u):
     """Derivative of the quintic with respect to ``u``."""
     return c1 + u * (2.0 * c2 + u * (3.0 * c3 + u * (4.0 * c4 + u * 5.0 * c5)))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def quintic_and_slope(c0, c1, c2, c3, c4, c5, u):
     """Value and derivative of the quintic at ``u``: one Horner pass, fused (two short chains)."""
     d = c5
@@ -70,7 +71,7 @@ def quintic_and_slope(c0, c1, c2, c3, c4, c5, u):
     return q, d
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def bracketed_root(c0, c1, c2, c3, c4, c5, lo, hi, derivative):
     """Root in ``[lo, hi]`` of the quintic (or of its derivative) that changes sign there.
 
@@ -118,7 +119,7 @@ def bracketed_root(c0, c1, c2, c3, c4, c5, lo, hi, derivative):
     return u
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def hermite_extremum(g0, d0, g1, d1):
     """Interior extremum of the cubic Hermite interpolant on [0, 1]: (u, value) or (-1, 0).
 
@@ -153,7 +154,7 @@ def hermite_extremum(g0, d0, g1, d1):
     return best_u, best_v
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def rotation_extremum(th0, om0, al0, th1, om1, al1, h):
     """Peak |theta| inside a rocking step in which theta_dot changes sign, and its time.
 
@@ -171,10 +172,10 @@ def rotation_extremum(th0, om0, al0, th1, om1, al1, h):
     return quintic_extremum(c0, c1, c2, c3, c4, c5, th0, th1, h)
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def quintic_extremum(c0, c1, c2, c3, c4, c5, th0, th1, h):
     """:func:`rotation_extremum` from the step's interpolant ``(c0, ..., c5)``."""
-    u = bracketed_root(c0, c1, c2, c3, c4, c5, 0.0, 1.0, True)
+    u = bracketed_root(c0, c1, c2, c3, c4, c5, 0.0, 1.0, np.bool_(True))
     if u < 0.0:
         return max(abs(th0), abs(th1)), 0.0
     return abs(poly5(c0, c1, c2, c3, c4, c5, u)), u * h
@@ -185,7 +186,7 @@ def quintic_extremum(c0, c1, c2, c3, c4, c5, th0, th1, h):
 PEAK_BOUND_MARGIN = 1e-9
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def rotation_peak(peak, peak_time, th0, om0, al0, th1, om1, al1, h, t0, t1):
     """The running peak of |theta| and its time, updated with an accepted rocking step.
 

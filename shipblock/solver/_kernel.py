@@ -10,10 +10,24 @@ method on the step length (an impact starting from the root of the step's quinti
 interpolant). The state is advanced to the root, the event is applied, and the next mode is
 chosen among all candidate modes consistent with the velocities by :func:`select_mode`.
 
-Nothing here allocates per step; the kernels take only arrays and scalars. :func:`run` only
-allocates the work arrays: the loop itself (:func:`integrate`), mode selection and the functions
-it calls are compiled without reference counting, like the closed-form span (see
+Nothing here allocates per step; the kernels take only arrays and scalars.
+:func:`run_cases`, the one compiled entry point (:func:`run` and
+:func:`~shipblock.simulate_batch` call it), only allocates the work arrays: the loop itself
+(:func:`integrate`), mode selection and the functions it calls are compiled without reference
+counting, like the closed-form span (see
 :mod:`~shipblock.solver._closed_form`).
+
+Compilation. The small functions of the step (``forceinline=True`` throughout the solver's
+modules) are inlined by LLVM, not by numba: numba's own inlining (``inline="always"``) typed
+and copied a function's body again at every call site, in every caller, which took most of the
+two minutes the first run spent compiling. Each is now typed and compiled once and marked
+``alwaysinline``; LLVM inlines it where it is called, so the machine code and the results are
+those of before, bit for bit, at the same speed (docs/benchmarks). The other functions say
+``forceinline=False``: numba hands the flags of a function being compiled down to the callees
+it compiles for it, and a function that should stay out of line must not inherit the flag
+from whichever caller compiled it first. Constants passed to compiled functions are typed
+``np.int64(0)`` or ``np.bool_(True)`` where a plain ``0`` or ``True`` would be a literal:
+numba compiles a function once more for each literal argument.
 """
 
 from __future__ import annotations
@@ -21,7 +35,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from shipblock.equations import (
     I_FX,
@@ -135,7 +149,7 @@ from shipblock.solver._workqueue import claim_next
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def rhs(p, ms, y, a, ay, stages, st, w7):
     """Time derivative of the state in the mode ``ms`` into ``stages[st]``; False if singular."""
     rock = ms[MS_ROCK]
@@ -158,7 +172,7 @@ def rhs(p, ms, y, a, ay, stages, st, w7):
     return ok
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
             first_stage_known, rtol, atol):
     """One Dormand-Prince 5(4) step of ``h`` within sample interval ``k``: its error norm.
@@ -187,7 +201,7 @@ def advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, 
     return error_norm(y0, y1, stages, h, rtol, atol)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def advance_general(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7,
                     first_stage_known):
     """The step of :func:`advance` in any rocking mode, on the whole state: False if singular.
@@ -217,7 +231,7 @@ def advance_general(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def error_norm(y0, y1, stages, h, rtol, atol):
     """RMS of the embedded error estimate scaled by atol + rtol*|y| over the dynamic states."""
     acc = 0.0
@@ -231,7 +245,7 @@ def error_norm(y0, y1, stages, h, rtol, atol):
     return math.sqrt(acc / N_DYN)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g, w7):
     """Fill ``g`` with the event functions at (t_k + tau, y); ``w7`` gets accelerations/forces."""
     a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)
@@ -243,7 +257,7 @@ def event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, g, w7):
     return ok
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def event_slope(e, ms, y, w7):
     """Time derivative of the velocity-type event functions (0 for the others)."""
     if e == EV_G_SLIP:
@@ -255,7 +269,7 @@ def event_slope(e, ms, y, w7):
     return 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def start_slope(e, ms, y, acc_b, acc_s):
     """Slope of a velocity-type event function at the start of a step.
 
@@ -268,13 +282,13 @@ def start_slope(e, ms, y, acc_b, acc_s):
     return ms[MS_S] * y[Y_OM]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def has_slope(e):
     """Whether event ``e`` has a slope at the ends of a step (a velocity or the rotation)."""
     return e in (EV_G_SLIP, EV_S_SLIP, EV_IMPACT)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g):
     """Event function ``e`` after advancing ``y0`` by ``h`` (state left in ``y1``).
 
@@ -282,7 +296,7 @@ def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages,
     all event functions there, except for the events of the rotation alone (impact,
     overturning), which need no forces.
     """
-    advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, True, 1.0,
+    advance(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, np.bool_(True), 1.0,
             1.0)
     if e in (EV_IMPACT, EV_OVERTURN):
         return rotation_event(p, ms, e, y1[Y_TH])
@@ -290,7 +304,7 @@ def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages,
     return g[e]
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has_ay, sh, sv,
                 y1, stages, ytmp, w7, g):
     """Illinois iteration for the step length at which event ``e`` crosses zero.
@@ -341,19 +355,19 @@ def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has
     return hi
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def mode_number_of(slip1, rock, slip2):
     """Paper mode number (1..8) of the three interface flags."""
     return MODE_NUMBER[slip1, rock, slip2]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def mode_number(ms):
     """Paper mode number (1..8) of a mode state vector."""
     return mode_number_of(ms[MS_SLIP1], ms[MS_ROCK], ms[MS_SLIP2])
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def interface_option(v, i):
     """Option ``i`` (0..2) of an interface whose motion has velocity ``v``: (flag, sign, new).
 
@@ -369,7 +383,7 @@ def interface_option(v, i):
     return flag, (-1 if i == 2 else 1), flag
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def interface_violation(held, excess, new, push):
     """How much a candidate violates one interface's conditions (0 when it satisfies them).
 
@@ -384,7 +398,7 @@ def interface_violation(held, excess, new, push):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def candidate_options(idx, vb, rot, vs):
     """Interface options of candidate ``idx`` (0..26): three (flag, sign, new) triples.
 
@@ -439,7 +453,7 @@ def _candidate_order():
 CANDIDATE_KEYS, CANDIDATE_COUNTS = _candidate_order()
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def select_mode(p, y, ms, a, b, trigger, w7, work):
     """Choose the next mode among the candidates consistent with the velocities.
 
@@ -551,7 +565,7 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
     return 1
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def blocks_lift_off(p, y, a, G, w7):
     """Whether the blocks leaving the ground is a consistent continuation at state ``y``.
 
@@ -578,7 +592,7 @@ def blocks_lift_off(p, y, a, G, w7):
     return False
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def ship_lifts_off(p, y, a, G, w7):
     """Whether the ship leaving the blocks is a consistent continuation at state ``y``.
 
@@ -630,7 +644,7 @@ def ship_lifts_off(p, y, a, G, w7):
     return False
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K):
     """:func:`select_mode`, with a jam of a slipping interface when no mode is consistent.
 
@@ -699,7 +713,7 @@ def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K):
     return status, loss, jam, jam_from
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def log_event(ev_t, ev_kft, log_size, n_ev, t, kind, from_mode, to_mode):
     """Write event ``n_ev`` (time, kind, modes before and after) if the log has room: n_ev + 1."""
     if n_ev < log_size:
@@ -710,10 +724,9 @@ def log_event(ev_t, ev_kft, log_size, n_ev, t, kind, from_mode, to_mode):
     return n_ev + 1
 
 
-@njit(cache=True)
 def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes, ev_t,
         ev_kft, summary, y_init):
-    """Integrate one record.
+    """Integrate one record: a batch of one case of :func:`run_cases`.
 
     Parameters
     ----------
@@ -747,28 +760,27 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
     y_init : ndarray, shape (6,)
         Initial ``(x_b, theta, x_s, v_b, theta_dot, v_s)``.
     """
-    vectors = np.zeros((5, N_STATE))
-    stages = np.zeros((7, N_STATE))
-    w7 = np.zeros((2, N_SOLVE_OUT))
-    K = np.zeros((3, 3))
-    g = np.zeros((3, N_EVENTS))
-    # the closed-form spans' work array: response vectors of the non-rocking modes, solved
-    # once per run, and the like (see nonrocking_span)
-    span_work = np.zeros(N_SPAN_WORK)
-    armed = np.ones(N_EVENTS, dtype=np.bool_)
-    ms = np.zeros(6, dtype=np.int64)
-    integrate(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes,
-              ev_t, ev_kft, summary, y_init, vectors[0], vectors[1], vectors[2], vectors[3],
-              vectors[4], stages, w7[0], w7[1], K, g[0], g[1], g[2], span_work, armed, ms)
+    ints = np.zeros((3, 1), dtype=np.int64)  # record, parameter row, claim counter
+    # numba types a read-only array apart: it would compile the whole solver once more for one
+    if not ax.flags.writeable:
+        ax, ay = np.array(ax), (None if ay is ax else ay)
+        ay = ax if ay is None else ay
+    if not ay.flags.writeable:
+        ay = np.array(ay)
+    run_cases(np.ascontiguousarray(p_vec).reshape(1, -1), ax, ay,
+              np.array([0, ax.shape[0]], dtype=np.int64), np.array([float(dt)]),
+              np.array([has_ay], dtype=np.bool_), ints[0], ints[1], np.array([float(sh)]),
+              np.array([float(sv)]), rtol, atol, zeno_omega, ints[2], summary.reshape(1, -1),
+              bool(store), hist, modes, ev_t, ev_kft, np.asarray(y_init, dtype=float))
 
 
 # IEEE division (error_model="numpy") as in the closed-form span inlined here: the default
 # would add a zero test before every division
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, forceinline=False, error_model="numpy", _nrt=False)
 def integrate(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes,
               ev_t, ev_kft, summary, y_init, y, y1, yr, ytmp, f_end, stages, w7, w7b, K, g0, g1,
               gw, span_work, armed, ms):
-    """The integration of :func:`run`, in work arrays allocated there.
+    """The integration of one case of :func:`run_cases`, in work arrays allocated there.
 
     Compiled without reference counting: numba would otherwise update the counts of the work
     arrays, atomically, around the functions inlined into the loop, which cost about a quarter
@@ -818,12 +830,14 @@ summary, y_init
 
     for i in range(N_DYN):
         y[i] = y_init[i]
-    k = 0
+    # the sample index and "no trigger" typed int64 from the start, not as the literals 0 and
+    # -1: numba would compile every function they are passed to once more for the literal
+    k = np.int64(0)
     tau = 0.0
-    a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, 0, ONE_SIDED_DT, dt)
-    a_wide, b_wide = ground_motion_at(ax, ay, has_ay, sh, sv, 0, ONE_SIDED_WIDE, dt)
+    a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, k, ONE_SIDED_DT, dt)
+    a_wide, b_wide = ground_motion_at(ax, ay, has_ay, sh, sv, k, ONE_SIDED_WIDE, dt)
     status, jam_loss, jammed, jam_from = resolve_mode(p_vec, y, ms, a_next, b_next, a_wide,
-                                                      b_wide, -1, w7, span_work, K)
+                                                      b_wide, np.int64(-1), w7, span_work, K)
     if status == 2:
         failure = Failure.SEPARATION
         failure_time = 0.0
@@ -849,7 +863,7 @@ summary, y_init
                          0 if failure else mode_number(ms))
     if ms[MS_ROCK]:
         uplift = 1
-    event_values(p, ms, y, 0, 0.0, dt, ax, ay, has_ay, sh, sv, g0, w7)
+    event_values(p, ms, y, k, 0.0, dt, ax, ay, has_ay, sh, sv, g0, w7)
     if failure == 0:
         note_loads(p, ms[MS_ROCK], w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY], summary)
     if store:
@@ -858,10 +872,10 @@ summary, y_init
             # so that the energy balance of the histories starts from it
             vb_jam, om_jam, vs_jam = y[Y_VB], y[Y_OM], y[Y_VS]
             y[Y_VB], y[Y_OM], y[Y_VS], y[Y_IMP] = y_init[3], y_init[4], y_init[5], 0.0
-            store_sample(p, ms, y, hist, modes, 0, 0 if failure else mode_number(ms))
+            store_sample(p, ms, y, hist, modes, k, 0 if failure else mode_number(ms))
             y[Y_VB], y[Y_OM], y[Y_VS], y[Y_IMP] = vb_jam, om_jam, vs_jam, jam_loss
         else:
-            store_sample(p, ms, y, hist, modes, 0, 0 if failure else mode_number(ms))
+            store_sample(p, ms, y, hist, modes, k, 0 if failure else mode_number(ms))
     h_rock = dt
     events_here = 0
     g0_stale = False
@@ -928,7 +942,7 @@ summary, y_init
                         failure_time = k * dt + tau
                         break
                     continue
-                t_return = impact_return_time(ms[MS_S], y[Y_TH], y[Y_OM], stages[0, Y_OM])
+                t_return = impact_return_time(float(ms[MS_S]), y[Y_TH], y[Y_OM], stages[0, Y_OM])
                 if h > t_return >= MIN_STEP:
                     # from an impact, no step past the rotation's return to zero: see
                     # impact_return_time (stages[0] stays f(y) for the shorter step)
@@ -990,7 +1004,7 @@ summary, y_init
                                 # first guess: the root of the step's quintic interpolant of theta
                                 c0, c1, c2, c3, c4, c5 = quintic_hermite(
                                     y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h)
-                                u = bracketed_root(c0, c1, c2, c3, c4, c5, lo / h, hi / h, False)
+                                u = bracketed_root(c0, c1, c2, c3, c4, c5, lo / h, hi / h, np.bool_(False))
                                 if u >= 0.0:
                                     guess = u * h
                             root = locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y, k, tau, dt,
@@ -1171,35 +1185,94 @@ summary, y_init
     ) + potential_energy(p, y[Y_TH])
 
 
-@njit(cache=True, parallel=True)
-def run_many(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
-             case_sv, rtol, atol, zeno_omega, n_workers, next_case, summaries):
-    """Run many cases in parallel; each case is (record, parameter row, H scale, V scale).
+@njit(cache=True, forceinline=False, nogil=True)
+def run_cases(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
+              case_sv, rtol, atol, zeno_omega, next_case, summaries, store, hist, modes, ev_t,
+              ev_kft, y_init):
+    """Run cases until none is left; each case is (record, parameter row, H scale, V scale).
+
+    The one compiled entry point of the solver: :func:`run` (one record, with its histories)
+    and :func:`~shipblock.simulate_batch` (many cases, summaries only) both call it, so that
+    the integration is compiled once, for one caller.
 
     Records are concatenated in ``acc_h``/``acc_v``; record ``r`` occupies
-    ``offsets[r]:offsets[r+1]``. Only summaries are produced. Each of ``n_workers`` workers
-    (one per thread) claims the next unclaimed case from the counter ``next_case`` (int64,
-    length 1, zero on entry) until none is left, so uneven case costs do not idle a thread.
-    The caller owns both: numba's ``get_num_threads`` in compiled code would keep this
-    function out of the on-disk cache, and the counter must live outside the compiled
-    function, whose optimiser does not see the atomic writes to an array it allocated.
+    ``offsets[r]:offsets[r+1]``. The caller claims the next unclaimed case from the counter
+    ``next_case`` (int64, length 1, zero at the start of the batch) until none is left, so that
+    several threads calling this at once on the same arguments share the cases out
+    dynamically: uneven case costs do not idle a thread, and a thread the operating system sets
+    aside holds up at most the one case it has claimed. The GIL is released (``nogil``) and
+    the threads are Python's (:mod:`shipblock.solver._threads`): no parallel region of
+    numba's, whose worker threads spin at its barrier, and which takes seconds more to compile.
+    The counter must live outside the compiled function, whose optimiser does not see the
+    atomic writes to an array it allocated.
+
+    Parameters
+    ----------
+    params : ndarray, shape (n_systems, n_parameters)
+        Parameter vectors, one row per system.
+    acc_h, acc_v, offsets, dts, has_v : ndarray
+        The records (see :class:`~shipblock.solver._inputs.RecordSet`); ``acc_v`` of a record
+        is ignored unless ``has_v``.
+    case_record, case_params, case_sh, case_sv : ndarray, shape (n_cases,)
+        Each case's record, parameter row and horizontal and vertical scale factors.
+    rtol, atol, zeno_omega : float
+        As for :func:`run`.
+    next_case : ndarray of int64, shape (1,)
+        The claim counter.
+    summaries : ndarray, shape (n_cases, N_SUMMARY)
+        Receives each case's summary.
+    store, hist, modes, ev_t, ev_kft : bool and ndarray
+        Histories and event log as for :func:`run`, for a batch of one case only (False and
+        empty arrays otherwise).
+    y_init : ndarray, shape (6,)
+        Initial state of every case.
     """
     n_cases = case_record.shape[0]
-    empty_hist = np.zeros((N_HIST, 0))
-    empty_modes = np.zeros(0, dtype=np.int64)
-    empty_t = np.zeros(0)
-    empty_kft = np.zeros((3, 0), dtype=np.int64)
-    at_rest = np.zeros(N_DYN)
-    # a run-time False: a literal would make numba compile ``run`` a second time for it
-    store = n_cases < 0
-    for _ in prange(min(n_workers, n_cases)):
-        while True:
-            c = claim_next(next_case)
-            if c >= n_cases:
-                break
-            r = case_record[c]
-            a0 = offsets[r]
-            a1 = offsets[r + 1]
-            run(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
-                case_sv[c], dts[r], rtol, atol, zeno_omega, store, empty_hist, empty_modes,
-                empty_t, empty_kft, summaries[c], at_rest)
+    # the work arrays of integrate, allocated once per call and reset for every case
+    vectors = np.zeros((5, N_STATE))
+    stages = np.zeros((7, N_STATE))
+    w7 = np.zeros((2, N_SOLVE_OUT))
+    K = np.zeros((3, 3))
+    g = np.zeros((3, N_EVENTS))
+    # the closed-form spans' work array: response vectors of the non-rocking modes, solved
+    # once per run, and the like (see nonrocking_span)
+    span_work = np.zeros(N_SPAN_WORK)
+    armed = np.ones(N_EVENTS, dtype=np.bool_)
+    ms = np.zeros(6, dtype=np.int64)
+    first = True
+    while True:
+        c = claim_next(next_case)
+        if c >= n_cases:
+            break
+        if not first:
+            # every case starts from the work arrays as allocated: zeros, all events armed
+            _reset_work(vectors, stages, w7, K, g, span_work, armed, ms)
+        first = False
+        r = case_record[c]
+        a0 = offsets[r]
+        a1 = offsets[r + 1]
+        integrate(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
+                  case_sv[c], dts[r], rtol, atol, zeno_omega, store, hist, modes, ev_t, ev_kft,
+                  summaries[c], y_init, vectors[0], vectors[1], vectors[2], vectors[3],
+                  vectors[4], stages, w7[0], w7[1], K, g[0], g[1], g[2], span_work, armed, ms)
+
+
+def no_histories():
+    """Empty ``(hist, modes, ev_t, ev_kft)`` for :func:`run_cases` without histories."""
+    return (np.zeros((N_HIST, 0)), np.zeros(0, dtype=np.int64), np.zeros(0),
+            np.zeros((3, 0), dtype=np.int64))
+
+
+@njit(cache=True, forceinline=True, _nrt=False)
+def _reset_work(vectors, stages, w7, K, g, span_work, armed, ms):
+    """The work arrays of :func:`run_cases` back to their state as allocated."""
+    for a in (vectors, stages, w7, K, g):
+        for i in range(a.shape[0]):
+            for j in range(a.shape[1]):
+                a[i, j] = 0.0
+    for i in range(span_work.shape[0]):
+        span_work[i] = 0.0
+    for i in range(armed.shape[0]):
+        armed[i] = True
+    for i in range(ms.shape[0]):
+        ms[i] = 0

@@ -105,7 +105,7 @@ MIN_FACTOR = 0.2
 MAX_FACTOR = 5.0
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=False)
 def parameter_tuple(p):
     """The parameter vector as a tuple (see ``shipblock.system.P_*``, 14 entries)."""
     return (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11], p[12],

@@ -51,7 +51,7 @@ from shipblock.solver._layout import (
 from shipblock.system import P_G, P_MUS1, P_MUS2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def note_loads(p, rock, fx, fy, Fx, Fy, summary):
     """Raise the running peaks of the contact loads with the forces at one instant [N].
 
@@ -80,7 +80,7 @@ def note_loads(p, rock, fx, fy, Fx, Fy, summary):
         summary[S_PEAK_CORNER] = fy
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _note_response(p, wa, wg, a, G, summary):
     """:func:`note_loads` of a non-rocking mode at input ``(a, G)`` from its response vectors."""
     note_loads(p, 0, wa[I_FX] * a + wg[I_FX] * G, wa[I_FY] * a + wg[I_FY] * G,
@@ -92,7 +92,7 @@ def _note_response(p, wa, wg, a, G, summary):
 EXTREMES_BLOCK = 64
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def _extremes(ax, k0, k1):  # pragma: no cover - numba kernel
     """Least and greatest of ``ax[k0:k1]`` (``inf, -inf`` if empty).
 
@@ -123,7 +123,7 @@ def _extremes(ax, k0, k1):  # pragma: no cover - numba kernel
     return lo, hi
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def _extremes_with_vertical(ax, ay, sh, sv, grav, fx_a, fx_g, Fx_a, Fx_g, k0, k1):  # pragma: no cover
     """Extremes over samples ``k0:k1`` of ``fx``, ``Fx``, ``G = g + a_y`` and ``a / G``, by
     blocks as :func:`_extremes`."""
@@ -223,7 +223,7 @@ def span_loads(p, ms, work, ax, ay, has_ay, sh, sv, dt, k0, tau0, k1, tau1, summ
                 summary[S_PEAK_UTIL_S] = u
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def state_loads(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary):
     """:func:`note_loads` of the mode ``ms`` at state ``y`` and time ``t_k + tau`` (one solve of
     the equations into the work array ``w7``): the kernel calls it on both sides of an event."""

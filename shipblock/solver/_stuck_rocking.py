@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from shipblock.equations import (
@@ -95,7 +96,7 @@ C2, C3, C4, C5 = (float(DP_C[j]) for j in (1, 2, 3, 4))
 E1, E3, E4, E5, E6, E7 = (float(DP_E[j]) for j in (0, 2, 3, 4, 5, 6))  # DP_E[1] == 0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def small_angle_sincos(d):
     """``(sin d, cos d)`` by their Taylor series, for ``|d| <= SMALL_ANGLE``."""
     d2 = d * d
@@ -111,7 +112,7 @@ def small_angle_sincos(d):
 SHORT_ANGLE = 0.02
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def short_angle_sincos(d):
     """``(sin d, cos d)`` by their Taylor series to degree 7 and 6, for ``|d| <= SHORT_ANGLE``."""
     d2 = d * d
@@ -120,7 +121,7 @@ def short_angle_sincos(d):
     return sn, cs
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def turn(d):
     """``(sin d, cos d)`` of a stage's rotation within a step: the shortest accurate way."""
     ad = abs(d)
@@ -131,13 +132,13 @@ def turn(d):
     return math.sin(d), math.cos(d)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _turned(sd, cd, pr, qr, pp, qp, om):
     """Stage rates (theta_dd, power) after a turn ``(sd, cd)``: see :func:`stuck_step`."""
     return fma(cd, pr, sd * qr), om * fma(cd, pp, sd * qp)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _turn_coefficients(gain, kpow, s, c0, s0, a0, da, b0, db, G0, f):
     """``(P, Q)`` of the rate and of the power at the fraction ``f`` of the sample interval.
 
@@ -152,7 +153,7 @@ def _turn_coefficients(gain, kpow, s, c0, s0, a0, da, b0, db, G0, f):
             kpow * (a * c0 - s * ay * s0), kpow * (sa * s0 + ay * c0))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def stuck_step(p, gain, s, c0, s0, th0, om0, w0, al1, pw1, a0, da, b0, db, f0, fh, h):
     """One Dormand-Prince 5(4) step of ``h`` in mode 3, in scalars.
 
@@ -234,14 +235,14 @@ def stuck_step(p, gain, s, c0, s0, th0, om0, w0, al1, pw1, a0, da, b0, db, f0, f
     return th0 + d7, om7, w1, al7, pw7, c7, sn7, e_th, e_om
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _rotating_coefficients(gain, ks, kpow, kps, a0, da, b0, db, G0, f):
     """Coefficients of ``u`` and ``v`` in the rate and the power at the fraction ``f`` of a sample."""
     a = a0 + da * f
     return gain * a, ks * (G0 + db * f), kpow * a, kps * (b0 + db * f)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def rotating_step(p, gain, s, c0, s0, th0, om0, w0, al1, pw1, a0, da, b0, db, h):
     """One Dormand-Prince 5(4) step of a whole sample interval in mode 3, geometry as states.
 
@@ -318,7 +319,7 @@ def rotating_step(p, gain, s, c0, s0, th0, om0, w0, al1, pw1, a0, da, b0, db, h)
     return th7, om7, w7, al7, pw7, u7, v7, e_th, e_om
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def stuck_error_norm(th0, om0, th1, om1, e_th, e_om, rtol, atol):
     """The error norm of :func:`~shipblock.solver._kernel.error_norm` for a mode-3 step."""
     sc_th = atol + rtol * max(abs(th0), abs(th1))
@@ -326,14 +327,14 @@ def stuck_error_norm(th0, om0, th1, om1, e_th, e_om, rtol, atol):
     return math.sqrt(((e_th / sc_th) ** 2 + (e_om / sc_om) ** 2) / N_DYN)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def is_stuck_rocking(ms, y):
     """Whether mode ``ms`` at state ``y`` is mode 3: rocking, no interface slipping."""
     return (ms[MS_ROCK] != 0 and ms[MS_SLIP1] == 0 and ms[MS_SLIP2] == 0 and y[Y_VB] == 0.0
             and y[Y_VS] == 0.0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def advance_stuck(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, w7,
                   first_stage_known, rtol, atol):
     """One Dormand-Prince 5(4) step of ``h`` in mode 3: the error norm (>= 0).
@@ -359,7 +360,7 @@ def advance_stuck(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, 
         pw1 = stages[0, Y_WIN]
     else:
         al1, pw1 = stuck_rocking_rates(p, gain, c0, s0, s, om0, a0 + da * f0, b0 + db * f0)
-        _store_rates(y0, om0, al1, pw1, stages, 0)
+        _store_rates(y0, om0, al1, pw1, stages, np.int64(0))
     th1, om1, w1, al7, pw7, c7, sn7, e_th, e_om = stuck_step(
         p, gain, s, c0, s0, th0, om0, y0[Y_WIN], al1, pw1, a0, da, b0, db, f0, h / dt, h)
     for i in range(N_STATE):
@@ -367,13 +368,13 @@ def advance_stuck(p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages, 
     y1[Y_TH] = th1
     y1[Y_OM] = om1
     y1[Y_WIN] = w1
-    _store_rates(y0, om1, al7, pw7, stages, 6)
+    _store_rates(y0, om1, al7, pw7, stages, np.int64(6))
     f = (tau + h) / dt
     stuck_forces_into(p, s, c7, sn7, om1, al7, a0 + da * f, b0 + db * f, w7)
     return stuck_error_norm(th0, om0, th1, om1, e_th, e_om, rtol, atol)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _store_rates(y0, om, al, pw, stages, st):
     """Row ``st`` of the stages: the rates of the whole state in mode 3."""
     for i in range(N_STATE):
@@ -385,7 +386,7 @@ def _store_rates(y0, om, al, pw, stages, st):
     stages[st, Y_WIN] = pw
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def stuck_forces_into(p, s, c, sn, om, al, a, ay, w7):
     """``w7``: the accelerations and interface forces of mode 3 at geometry ``(c, sn)``."""
     fx, fy, Fx, Fy = stuck_rocking_forces(p, c, sn, s, om, al, a, p[P_G] + ay)
@@ -398,7 +399,7 @@ def stuck_forces_into(p, s, c, sn, om, al, a, ay, w7):
     w7[I_SFY] = Fy
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, forceinline=False, error_model="numpy", _nrt=False)
 def locate_impact(p, gain, s, c, sn, th, om, w, al, pw, th1, om1, al1, a0, da, b0, db, f0, h, dt):
     """Time to the impact inside an accepted mode-3 step: ``(ok, t, theta, omega, work, alpha)``.
 
@@ -421,10 +422,10 @@ def locate_impact(p, gain, s, c, sn, th, om, w, al, pw, th1, om1, al1, a0, da, b
     lo = 0.0
     if th == 0.0:
         # from the impact before: out and back within the step; the root is past the turn
-        lo = bracketed_root(c0, c1, c2, c3, c4, c5, 0.0, 1.0, True)
+        lo = bracketed_root(c0, c1, c2, c3, c4, c5, 0.0, 1.0, np.bool_(True))
         if not lo > 0.0:
             return False, 0.0, 0.0, 0.0, 0.0, 0.0
-    u = bracketed_root(c0, c1, c2, c3, c4, c5, lo, 1.0, False)
+    u = bracketed_root(c0, c1, c2, c3, c4, c5, lo, 1.0, np.bool_(False))
     if not u > lo:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0
     t = u * h
@@ -450,7 +451,7 @@ def locate_impact(p, gain, s, c, sn, th, om, w, al, pw, th1, om1, al1, a0, da, b
 STEP_ACCEPTED, STEP_REFUSED, STEP_TO_IMPACT = 0, 1, 2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0, fh, h, dt,
                  rtol, atol, armed, g1, need_g, whole):
     """One mode-3 step of the span to the next sample, and what the span makes of it.
@@ -513,7 +514,7 @@ def checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0
             al_i)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, forceinline=False, error_model="numpy", _nrt=False)
 def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol, armed, g0, g1,
                        peak_th, peak_th_time, store, hist, modes, mode, summary):
     """Advance mode 3 to the next sample and on by whole samples, up to the next event.
@@ -601,7 +602,8 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
                 fh = h / dt
             (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i,
              w_i, al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0,
-                                       b1, f0, fh, h, dt, rtol, atol, armed, g1, True, False)
+                                       b1, f0, fh, h, dt, rtol, atol, armed, g1, np.bool_(True),
+                                       np.bool_(False))
             if verdict == STEP_ACCEPTED:
                 all_armed = rearm(armed, g1)
                 note_loads(p, 1, fx1, fy1, Fx1, Fy1, summary)
@@ -631,7 +633,7 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
         b1 = sv * ay[k + 1] if has_ay else 0.0
         (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i, w_i,
          al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, 0.0,
-                              1.0, dt, dt, rtol, atol, armed, g1, not all_armed, True)
+                              1.0, dt, dt, rtol, atol, armed, g1, not all_armed, np.bool_(True))
         if verdict != STEP_ACCEPTED:
             break
         note_loads(p, 1, fx1, fy1, Fx1, Fy1, summary)

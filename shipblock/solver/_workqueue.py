@@ -4,8 +4,10 @@ numba's ``prange`` deals the iterations out in one contiguous block per thread b
 loop starts. Simulation costs differ by orders of magnitude between cases (a run that fails
 in its first second against one that rocks through the whole record), so a fixed deal leaves
 threads idle while one finishes the heavy block. Workers that each claim the next unclaimed
-case keep every thread busy until the list is empty. numba has no atomic operations on the
-CPU, so the claim is one LLVM ``atomicrmw add`` emitted by an intrinsic.
+case keep every thread busy until the list is empty (the batch's workers are Python threads
+running :func:`~shipblock.solver._kernel.run_cases`, see :mod:`shipblock.solver._threads`).
+numba has no atomic operations on the CPU, so the claim is one LLVM ``atomicrmw add`` emitted
+by an intrinsic.
 """
 
 from __future__ import annotations
@@ -33,7 +35,8 @@ def claim_next(typingctx, counter):
         first = cgutils.gep_inbounds(builder, array.data, 0)
         one = context.get_constant(types.int64, 1)
         # monotonic ordering suffices: each value is handed out once, and the results the
-        # workers write are published by the join at the end of the parallel region
+        # workers write are published by the join that ends the batch (the threads' join, or
+        # a parallel region's barrier)
         return builder.atomic_rmw("add", first, one, "monotonic")
 
     return sig, codegen
