@@ -631,20 +631,15 @@ _SLOW_RUN = textwrap.dedent(
 )
 
 
-def test_resume_after_sigkill_gives_same_result(tmp_path, monkeypatch):
-    path = write_pipeline(tmp_path, chunk_size=1)  # 15 chunks of one run
-    reference = run_pipeline(path, output=tmp_path / "reference.nc", progress=False)
-
-    out = tmp_path / "killed.nc"
-    partial = tmp_path / "killed.nc.partial"
-    proc = subprocess.Popen([sys.executable, "-c", _SLOW_RUN, str(path), str(out)])
+def _run_until(proc, condition, what):
+    """Wait until ``condition()`` holds, then SIGKILL ``proc``."""
     try:
-        deadline = time.monotonic() + 120
+        deadline = time.monotonic() + 180
         while time.monotonic() < deadline:
-            if partial.is_dir() and len(list(partial.glob("chunk-*.npz"))) >= 2:
+            if condition():
                 break
             if proc.poll() is not None:
-                pytest.fail("the run ended before it could be killed")
+                pytest.fail(f"the run ended before {what}")
             time.sleep(0.02)
         os.kill(proc.pid, signal.SIGKILL)
         proc.wait(timeout=30)
@@ -652,6 +647,17 @@ def test_resume_after_sigkill_gives_same_result(tmp_path, monkeypatch):
         if proc.poll() is None:
             proc.kill()
     assert proc.returncode == -signal.SIGKILL
+
+
+def test_resume_after_sigkill_gives_same_result(tmp_path, monkeypatch):
+    path = write_pipeline(tmp_path, chunk_size=1)  # 15 chunks of one run
+    reference = run_pipeline(path, output=tmp_path / "reference.nc", progress=False)
+
+    out = tmp_path / "killed.nc"
+    partial = tmp_path / "killed.nc.partial"
+    proc = subprocess.Popen([sys.executable, "-c", _SLOW_RUN, str(path), str(out)])
+    _run_until(proc, lambda: partial.is_dir() and len(list(partial.glob("chunk-*.npz"))) >= 2,
+               "it could be killed")
     assert not out.exists()
     done = len(list(partial.glob("chunk-*.npz")))
     assert 2 <= done < 15
@@ -680,24 +686,6 @@ _SLOW_FITS = textwrap.dedent(
     pipeline.run_pipeline(sys.argv[1], output=sys.argv[2], progress=False)
     """
 )
-
-
-def _run_until(proc, condition, what):
-    """Wait until ``condition()`` holds, then SIGKILL ``proc``."""
-    try:
-        deadline = time.monotonic() + 180
-        while time.monotonic() < deadline:
-            if condition():
-                break
-            if proc.poll() is not None:
-                pytest.fail(f"the run ended before {what}")
-            time.sleep(0.02)
-        os.kill(proc.pid, signal.SIGKILL)
-        proc.wait(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode == -signal.SIGKILL
 
 
 def test_resume_after_sigkill_during_the_fits_gives_same_result(tmp_path, monkeypatch):
