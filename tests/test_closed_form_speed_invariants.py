@@ -18,7 +18,8 @@ from shipblock.solver._closed_form import (
     skip_rest,
     slip_may_stop,
 )
-from shipblock.solver._layout import parameter_tuple
+from shipblock.solver._layout import N_SUMMARY, S_PEAK_FX, S_PEAK_SFX, S_PEAK_UTIL_G, S_PEAK_UTIL_S, parameter_tuple
+from shipblock.solver._load_peaks import quiet_interval
 from shipblock.system import P_B, P_G, P_H, P_MUS1, P_MUS2
 
 
@@ -96,8 +97,11 @@ def test_rest_blocks_skip_exactly_the_passing_samples(has_ay, fast):
     for j in range(n):
         assert rest_breaks(ax[j], ay[j], has_ay, sh, sv, *c) == breaks[j]
     lo, hi = held_interval(0, 0, *c) if fast and not has_ay else (1.0, -1.0)
+    p = system.to_parameter_vector()
+    summary = np.zeros(N_SUMMARY)
     for k0 in list(rng.choice(n - 1, 60, replace=False)) + [0, n - 40, n - 2]:
-        k, time = skip_rest(ax, ay, has_ay, sh, sv, int(k0), dt, 0.25, *c, lo, hi)
+        k, time = skip_rest(ax, ay, has_ay, sh, sv, int(k0), dt, 0.25, *c, lo, hi, p,
+                            np.bool_(False), 1.0, -1.0, summary)
         assert k0 <= k <= n - 1
         assert not breaks[k0 + 1:k + 1].any()  # nothing skipped that the screen would stop at
         assert k == n - 1 or breaks[k + 1]  # stops at the first break
@@ -105,6 +109,58 @@ def test_rest_blocks_skip_exactly_the_passing_samples(has_ay, fast):
         for _ in range(k - k0):
             want += dt  # interval by interval, as the span adds it
         assert time == want
+
+
+def direct_rest_peaks(p, c, a_values):
+    """Peaks of |fx|, |Fx| and the two friction utilisations of rest over the scaled
+    accelerations ``a_values`` (no vertical input), each sample noted (Python)."""
+    grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2 = c[:11]
+    fx = np.abs(fx_a * a_values + fx_g * grav)
+    Fx = np.abs(Fx_a * a_values + Fx_g * grav)
+    return (fx.max(), Fx.max(), (fx / (mus1 * (fy_g * grav))).max(),
+            (Fx / (mus2 * (Fy_g * grav))).max())
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_rest_blocks_note_the_loads_of_every_sample_they_pass(seed):
+    """skip_rest with loads: the peaks over the samples passed are those of noting each one,
+    to the bit, though most blocks are passed by the two comparisons of the quiet interval;
+    and the break found is the one found without loads."""
+    system = ShipBlockSystem.example()
+    c = rest_coefficients(system)
+    p = system.to_parameter_vector()
+    rng = np.random.default_rng(seed)
+    n, dt, sh = 20000, 0.005, 1.3
+    # growing amplitude (new peaks keep coming) below the limit of rest, a few strong samples
+    ax = rng.normal(size=n) * np.linspace(0.05, 0.45, n)
+    for j in rng.choice(n, 8, replace=False):
+        ax[j] = 8.0
+    ay = np.zeros(n)
+    lo, hi = held_interval(0, 0, *c)
+    assert lo < hi
+    k = 0
+    summary = np.zeros(N_SUMMARY)
+    passed = np.zeros(n, dtype=bool)
+    n_spans = 0
+    while k < n - 1:
+        k0 = k
+        k_plain, _ = skip_rest(ax, ay, False, sh, 0.0, k0, dt, 0.0, *c, lo, hi, p,
+                               np.bool_(False), 1.0, -1.0, np.zeros(N_SUMMARY))
+        q_lo, q_hi = quiet_interval(p, c[0], c[1], c[2], c[4], c[5], c[6], c[8], summary)
+        k, _ = skip_rest(ax, ay, False, sh, 0.0, k0, dt, 0.0, *c, lo, hi, p, np.bool_(True),
+                         q_lo, q_hi, summary)
+        assert k == k_plain
+        passed[k0 + 1:k + 1] = True
+        if passed.any():
+            want = direct_rest_peaks(p, c, sh * ax[passed])  # every sample passed so far
+            got = (summary[S_PEAK_FX], summary[S_PEAK_SFX], summary[S_PEAK_UTIL_G],
+                   summary[S_PEAK_UTIL_S])
+            assert got == want, (k0, k, got, want)
+        n_spans += 1
+        k += 1  # over the break
+    assert n_spans > 5
+    # the peaks grew through the record: the quiet interval was recomputed, not just kept
+    assert 0.3 < summary[S_PEAK_UTIL_G] < 1.0
 
 
 def test_rest_interval_passes_the_screen_near_its_ends():

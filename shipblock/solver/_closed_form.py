@@ -86,6 +86,12 @@ from shipblock.solver._layout import (
     Y_XB,
     Y_XS,
 )
+from shipblock.solver._load_peaks import (
+    cached_quiet_interval,
+    folds_loads,
+    note_mode_loads,
+    quiet_interval,
+)
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
 NO_ROOT = math.inf
@@ -367,7 +373,7 @@ def add_repeated(t, dt, n):
 
 @njit(cache=True, forceinline=False, error_model="numpy", _nrt=False)
 def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g,
-              Fy_a, Fy_g, mus1, mus2, B, H, lo, hi):
+              Fy_a, Fy_g, mus1, mus2, B, H, lo, hi, p, loads, q_lo, q_hi, summary):
     """Advance rest from sample ``k`` to the first interval that fails the screen (see
     :func:`rest_breaks`), or to the end of the record.
 
@@ -376,6 +382,13 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
     intervals by whether their accelerations lie in ``[lo, hi]`` (two comparisons a sample),
     else ``REST_BLOCK`` by the screen itself, the first failing interval found by a minimum
     over the block's indices. The time is added at the end (:func:`add_repeated`).
+
+    With ``loads`` the contact loads of the samples passed are noted on the way
+    (:mod:`~shipblock.solver._load_peaks`): the fast blocks are checked against the
+    intersection of ``[lo, hi]`` with the :func:`~shipblock.solver._load_peaks.quiet_interval`
+    of rest, and a block that fails only the latter is counted again against ``[lo, hi]`` and
+    its samples outside the quiet interval noted; the samples screened one by one or by
+    ``REST_BLOCK`` are noted if outside it. The break found is the same either way.
 
     Parameters
     ----------
@@ -390,6 +403,16 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
     lo, hi : float
         Scaled horizontal accelerations at which rest surely passes the screen
         (:func:`held_interval` of rest; ``lo > hi`` for none, as with a vertical input).
+    p : ndarray
+        Parameter vector (for the friction coefficients of the loads).
+    loads : bool
+        Whether to note the loads of the samples passed (only where
+        :func:`~shipblock.solver._load_peaks.folds_loads`: no vertical input).
+    q_lo, q_hi : float
+        The :func:`~shipblock.solver._load_peaks.quiet_interval` of rest at the call (if
+        ``loads``).
+    summary : ndarray
+        The run's summary, whose load peaks are raised.
 
     Returns
     -------
@@ -400,12 +423,20 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
     """
     n = ax.shape[0]
     k0 = k
+    # the loads: samples in [q_lo, q_hi] raise no peak; the fast blocks check [f_lo, f_hi]
+    if not loads:
+        q_lo, q_hi = -math.inf, math.inf
+    f_lo, f_hi = max(lo, q_lo), min(hi, q_hi)
     while True:
         if k + REST_BLOCK >= n:
             # the last samples, one by one
             while k < n - 1 and not rest_breaks(ax[k + 1], ay[k + 1], has_ay, sh, sv, grav,
                                                  fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a,
                                                  Fy_g, mus1, mus2, B, H):
+                a1 = sh * ax[k + 1]
+                if loads and not q_lo <= a1 <= q_hi:
+                    note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, a1,
+                                    grav + 0.0, summary)
                 k += 1
             break
         # indices from 0 in a slice, so that the loads are contiguous (no negative-index
@@ -415,7 +446,23 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
             outside = 0
             for j in range(FAST_BLOCK):
                 a1 = sh * bx[j]  # as rest_breaks scales it
-                outside += (a1 < lo) | (a1 > hi)
+                outside += (a1 < f_lo) | (a1 > f_hi)
+            if outside != 0 and loads:
+                # a sample may raise a peak: if the block is all rest all the same, its
+                # samples outside the quiet interval are noted and the block passed
+                outside = 0
+                for j in range(FAST_BLOCK):
+                    a1 = sh * bx[j]
+                    outside += (a1 < lo) | (a1 > hi)
+                if outside == 0:
+                    for j in range(FAST_BLOCK):
+                        a1 = sh * bx[j]
+                        if not q_lo <= a1 <= q_hi:
+                            note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g,
+                                            a1, grav + 0.0, summary)
+                    q_lo, q_hi = quiet_interval(p, grav, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g,
+                                                summary)
+                    f_lo, f_hi = max(lo, q_lo), min(hi, q_hi)
             if outside == 0:
                 k += FAST_BLOCK
                 continue
@@ -426,6 +473,17 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
             bad = rest_breaks(bx[j], by[j], has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a,
                               Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
             first = min(first, j if bad else REST_BLOCK)
+        if loads:
+            noted = False
+            for j in range(first):  # the samples passed
+                a1 = sh * bx[j]
+                if not q_lo <= a1 <= q_hi:
+                    note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, a1,
+                                    grav + 0.0, summary)
+                    noted = True
+            if noted:
+                q_lo, q_hi = quiet_interval(p, grav, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, summary)
+                f_lo, f_hi = max(lo, q_lo), min(hi, q_hi)
         if first < REST_BLOCK:
             k += first
             break
@@ -496,7 +554,7 @@ def mode_response_start(p, work, slip1, sig1, slip2, sig2):
 # event, a few per cent of a stick-slip record's time
 @njit(cache=True, error_model="numpy", _nrt=False, forceinline=True)
 def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs,
-                    store, hist, modes, work):
+                    store, hist, modes, work, summary):
     """Advance a non-rocking mode sample by sample until an event or the end of the record.
 
     Parameters
@@ -526,6 +584,13 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         modes thousands of times); the inverse weights
         that scale the event functions, set by the first span; per response slot the
         interval of :func:`held_interval`, set with its response vectors.
+    summary : ndarray, shape (N_SUMMARY,)
+        The run's summary. Where :func:`~shipblock.solver._load_peaks.folds_loads` (no
+        vertical input), the contact loads of every sample the span passes are noted in its
+        peaks on the way, by the span's own scan: a sample inside the
+        :func:`~shipblock.solver._load_peaks.quiet_interval` is passed by two comparisons,
+        the others are noted. (The span's two ends are noted by
+        :func:`~shipblock.solver._loads.span_loads`, which the kernel calls next.)
 
     Returns
     -------
@@ -564,6 +629,9 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         work[W_INV_WR] = work[W_INV_W] / p[P_R]
     inv_w, inv_ws, inv_wr = work[W_INV_W], work[W_INV_WS], work[W_INV_WR]
     mode = MODE_NUMBER[slip1, 0, slip2]
+    loads = folds_loads(has_ay, fy_a, Fy_a)
+    q_lo, q_hi = cached_quiet_interval(p, work, slot, grav, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g,
+                                       summary) if loads else (1.0, -1.0)
     all_armed = True
     for e in range(N_EVENTS):
         if not armed[e]:
@@ -578,13 +646,22 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
                 lo <= sh * ax[k + 1] <= hi or not rest_breaks(
                     ax[k + 1], ay[k + 1], has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a,
                     Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)):
+            a1 = sh * ax[k + 1]
+            if loads and not q_lo <= a1 <= q_hi:
+                note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, a1,
+                                grav + 0.0, summary)
+                q_lo, q_hi = cached_quiet_interval(p, work, slot, grav, fx_a, fx_g, fy_g, Fx_a,
+                                                   Fx_g, Fy_g, summary)
             time_in_mode += dt - tau
             tau = 0.0
             k += 1
         if k - k_first == REST_FIRST:
             k, time_in_mode = skip_rest(ax, ay, has_ay, sh, sv, k, dt, time_in_mode, grav, fx_a,
                                         fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B,
-                                        H, lo, hi)
+                                        H, lo, hi, p, loads, q_lo, q_hi, summary)
+            if loads:
+                q_lo, q_hi = cached_quiet_interval(p, work, slot, grav, fx_a, fx_g, fy_g, Fx_a,
+                                                   Fx_g, Fy_g, summary)
         if store and k > k_first:
             _store_rest(p, y, hist, modes, k_first + 1, k + 1, mode)
     a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # start of the interval
@@ -683,6 +760,11 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         time_in_mode += h
         k += 1
         tau = 0.0
+        if loads and not q_lo <= a1 <= q_hi:
+            # the sample reached (G1 = g + 0.0 without a vertical input)
+            note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, a1, G1, summary)
+            q_lo, q_hi = cached_quiet_interval(p, work, slot, grav, fx_a, fx_g, fy_g, Fx_a, Fx_g,
+                                               Fy_g, summary)
         # the end of this interval is the start of the next: the same values, not recomputed
         a0 = a1
         G0 = G1

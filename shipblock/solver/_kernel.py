@@ -879,6 +879,7 @@ summary, y_init
     h_rock = dt
     events_here = 0
     g0_stale = False
+    loads_pending = False
     while k < n - 1 and failure == 0:
         if ms[MS_ROCK] == 0:
             # rest and sliding: closed form, sample by sample, up to the next event
@@ -887,11 +888,12 @@ summary, y_init
             span_impact = False
             k, tau, best_e, span_time, peak_xb, peak_xs = nonrocking_span(
                 p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs, store,
-                hist, modes, span_work)
+                hist, modes, span_work, summary)
             if best_e != -2:
                 summary[S_MODE_TIME + mode_number(ms) - 1] += span_time
                 span_loads(p_vec, ms, span_work, ax, ay, has_ay, sh, sv, dt, k_before,
                            tau_before, k, tau, summary)
+                loads_pending = False
             if k != k_before:
                 events_here = 0
             if best_e == -1:
@@ -1045,7 +1047,9 @@ summary, y_init
             fsal = False
             t_now = k * dt + tau
             from_mode = mode_number(ms)
-            state_loads(p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary)
+            if ms[MS_ROCK]:
+                # (a non-rocking mode's forces here are the end of its span, noted by span_loads)
+                state_loads(p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary)
             trigger = -1
             kind = EventKind.START
             jammed = 0
@@ -1115,7 +1119,12 @@ summary, y_init
                             armed[e] = True
                     if ms[MS_ROCK]:
                         uplift = 1
-                    state_loads(p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary)
+                    if ms[MS_ROCK]:
+                        state_loads(p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary)
+                    else:
+                        # a non-rocking mode's forces here start its span, noted by span_loads;
+                        # noted after the loop if no span follows
+                        loads_pending = True
             if failure != 0:
                 failure_time = t_now
             if jammed or kind != trigger_kind:
@@ -1157,6 +1166,8 @@ summary, y_init
             events_here = 0
             if store:
                 store_sample(p, ms, y, hist, modes, k, mode_number(ms))
+    if loads_pending:
+        state_loads(p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary)
     end_time = k * dt + tau
     if failure != 0 and store:
         for j in range(k + 1, n):

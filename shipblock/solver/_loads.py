@@ -1,6 +1,7 @@
 """Peak contact loads of a run: the interface forces' running peaks in the summary (compiled).
 
-The kernel hands every set of interface forces it has at hand to :func:`note_loads`: the forces
+The kernel hands every set of interface forces it has at hand to :func:`note_loads` (of
+:mod:`~shipblock.solver._load_peaks`, imported here): the forces
 ``(fx, fy)`` of the ground on the blocks and ``(Fx, Fy)`` of the blocks on the ship, totals over
 the ``n`` blocks [N]. It keeps the peaks of ``fy``, ``|fx|``, ``Fy``, ``|Fx|``, of the friction
 utilisations ``|fx| / (mu_s1 fy)`` and ``|Fx| / (mu_s2 Fy)`` and, while the blocks rock, of
@@ -12,7 +13,8 @@ Where the forces come from decides the accuracy:
 * rest and sliding (:func:`span_loads`): the forces are ``a w_a + G w_G`` with the mode's
   response vectors, linear in time between samples, and the utilisations ratios of such linear
   functions (monotone between samples), so the peaks over a span are at its samples and ends:
-  exact;
+  exact. Without a vertical input the closed-form span notes its samples itself, in its own
+  scan for the next event (:mod:`~shipblock.solver._load_peaks`);
 * rocking: the forces at the end of every accepted step (the steps' own last stage, at most one
   sample long) and on both sides of every event (:func:`state_loads`). Between step ends the
   forces vary smoothly and their peak can be missed by about ``h^2 |f''| / 8``
@@ -29,7 +31,7 @@ import math
 from numba import njit
 
 from shipblock.equations import I_FX, I_FY, I_SFX, I_SFY, N_SOLVE_OUT, solve_mode
-from shipblock.solver._closed_form import mode_response_start
+from shipblock.solver._closed_form import mode_response_start, response_slot
 from shipblock.solver._ground import ground_motion_at
 from shipblock.solver._layout import (
     MS_ROCK,
@@ -38,46 +40,18 @@ from shipblock.solver._layout import (
     MS_SIG2,
     MS_SLIP1,
     MS_SLIP2,
-    S_PEAK_CORNER,
-    S_PEAK_FX,
-    S_PEAK_FY,
-    S_PEAK_SFX,
-    S_PEAK_SFY,
     S_PEAK_UTIL_G,
     S_PEAK_UTIL_S,
     Y_OM,
     Y_TH,
 )
+from shipblock.solver._load_peaks import (
+    cached_quiet_interval,
+    folds_loads,
+    note_loads,
+    note_quiet_end,
+)
 from shipblock.system import P_G, P_MUS1, P_MUS2
-
-
-@njit(cache=True, forceinline=True)
-def note_loads(p, rock, fx, fy, Fx, Fy, summary):
-    """Raise the running peaks of the contact loads with the forces at one instant [N].
-
-    ``rock`` is nonzero while the blocks rock (``fy`` then rests on their pivot corners). NaN
-    forces (a singular mode) compare false and change nothing.
-    """
-    afx = abs(fx)
-    aFx = abs(Fx)
-    if fy > summary[S_PEAK_FY]:
-        summary[S_PEAK_FY] = fy
-    if afx > summary[S_PEAK_FX]:
-        summary[S_PEAK_FX] = afx
-    if Fy > summary[S_PEAK_SFY]:
-        summary[S_PEAK_SFY] = Fy
-    if aFx > summary[S_PEAK_SFX]:
-        summary[S_PEAK_SFX] = aFx
-    if fy > 0.0 and p[P_MUS1] > 0.0:
-        u = afx / (p[P_MUS1] * fy)
-        if u > summary[S_PEAK_UTIL_G]:
-            summary[S_PEAK_UTIL_G] = u
-    if Fy > 0.0 and p[P_MUS2] > 0.0:
-        u = aFx / (p[P_MUS2] * Fy)
-        if u > summary[S_PEAK_UTIL_S]:
-            summary[S_PEAK_UTIL_S] = u
-    if rock and fy > summary[S_PEAK_CORNER]:
-        summary[S_PEAK_CORNER] = fy
 
 
 @njit(cache=True, forceinline=True)
@@ -87,46 +61,19 @@ def _note_response(p, wa, wg, a, G, summary):
                wa[I_SFX] * a + wg[I_SFX] * G, wa[I_SFY] * a + wg[I_SFY] * G, summary)
 
 
-#: Samples checked at once against the running extremes of :func:`_extremes` (the extremes of
-#: a record settle early, so most blocks are passed by one vectorised comparison).
+#: Samples checked at once against the running extremes of :func:`_extremes_with_vertical`
+#: (the extremes of a record settle early, so most blocks are passed by one vectorised
+#: comparison).
 EXTREMES_BLOCK = 64
 
 
 @njit(cache=True, forceinline=False, _nrt=False)
-def _extremes(ax, k0, k1):  # pragma: no cover - numba kernel
-    """Least and greatest of ``ax[k0:k1]`` (``inf, -inf`` if empty).
-
-    A block of samples all inside the running ``[lo, hi]`` is passed after one branch-free
-    count (vectorised); only blocks holding a new extreme are scanned.
-    """
-    lo = math.inf
-    hi = -math.inf
-    j = k0
-    while j < k1:
-        end = min(j + EXTREMES_BLOCK, k1)
-        if end - j == EXTREMES_BLOCK and lo <= hi:
-            block = ax[j:end]
-            outside = 0
-            for i in range(EXTREMES_BLOCK):
-                x = block[i]
-                outside += (x < lo) | (x > hi)
-            if outside == 0:
-                j = end
-                continue
-        for i in range(j, end):
-            x = ax[i]
-            if x < lo:
-                lo = x
-            if x > hi:
-                hi = x
-        j = end
-    return lo, hi
-
-
-@njit(cache=True, forceinline=False, _nrt=False)
 def _extremes_with_vertical(ax, ay, sh, sv, grav, fx_a, fx_g, Fx_a, Fx_g, k0, k1):  # pragma: no cover
-    """Extremes over samples ``k0:k1`` of ``fx``, ``Fx``, ``G = g + a_y`` and ``a / G``, by
-    blocks as :func:`_extremes`."""
+    """Extremes over samples ``k0:k1`` of ``fx``, ``Fx``, ``G = g + a_y`` and ``a / G``.
+
+    A block of samples all inside the running extremes is passed after one branch-free count
+    (vectorised); only blocks holding a new extreme are scanned.
+    """
     fx_lo = Fx_lo = g_lo = r_lo = math.inf
     fx_hi = Fx_hi = g_hi = r_hi = -math.inf
     j = k0
@@ -175,8 +122,11 @@ def span_loads(p, ms, work, ax, ay, has_ay, sh, sv, dt, k0, tau0, k1, tau1, summ
     (``fy = fy_G G``, ``Fy = Fy_G G``), so over the samples: the peak normal forces are those
     of the greatest ``G``; the peak ``|fx|`` that of the greatest or least ``fx``; the peak
     utilisation ``|fx_a (a/G) + fx_G| / (mu fy_G)`` that of the greatest or least ``a/G``.
-    Without a vertical input ``G = g`` and the least and greatest sample of ``a`` stand for
-    all. (A mode whose normal forces did depend on ``a`` would be scanned sample by sample.)
+    Without a vertical input ``G = g`` and the samples' loads are noted by the span itself
+    (:func:`~shipblock.solver._load_peaks.folds_loads`): its scan for the next event passes
+    the samples inside :func:`~shipblock.solver._load_peaks.quiet_interval` by two comparisons
+    and notes the others, so only the span's ends are noted here. (A mode whose normal forces
+    did depend on ``a`` would be scanned sample by sample.)
     """
     start = mode_response_start(p, work, ms[MS_SLIP1], float(ms[MS_SIG1]), ms[MS_SLIP2],
                                 float(ms[MS_SIG2]))
@@ -185,6 +135,20 @@ def span_loads(p, ms, work, ax, ay, has_ay, sh, sv, dt, k0, tau0, k1, tau1, summ
     wa = work[start:start + N_SOLVE_OUT]
     wg = work[start + N_SOLVE_OUT:start + 2 * N_SOLVE_OUT]
     grav = p[P_G]
+    if folds_loads(has_ay, wa[I_FY], wa[I_SFY]):
+        # the span noted its samples' loads itself; an end inside the quiet interval can only
+        # raise the normal forces' peaks
+        q_lo, q_hi = cached_quiet_interval(
+            p, work, response_slot(ms[MS_SLIP1], float(ms[MS_SIG1]), ms[MS_SLIP2],
+                                   float(ms[MS_SIG2])),
+            grav, wa[I_FX], wg[I_FX], wg[I_FY], wa[I_SFX], wg[I_SFX], wg[I_SFY], summary)
+        a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k0, tau0, dt)
+        note_quiet_end(p, wa[I_FX], wg[I_FX], wg[I_FY], wa[I_SFX], wg[I_SFX], wg[I_SFY], a,
+                       grav + b, q_lo, q_hi, summary)
+        a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k1, tau1, dt)
+        note_quiet_end(p, wa[I_FX], wg[I_FX], wg[I_FY], wa[I_SFX], wg[I_SFX], wg[I_SFY], a,
+                       grav + b, q_lo, q_hi, summary)
+        return
     a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k0, tau0, dt)
     _note_response(p, wa, wg, a, grav + b, summary)
     a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k1, tau1, dt)
@@ -196,11 +160,6 @@ def span_loads(p, ms, work, ax, ay, has_ay, sh, sv, dt, k0, tau0, k1, tau1, summ
         for j in range(k0 + 1, last + 1):
             _note_response(p, wa, wg, sh * ax[j], grav + (sv * ay[j] if has_ay else 0.0),
                            summary)
-        return
-    if not has_ay:
-        lo, hi = _extremes(ax, k0 + 1, last + 1)
-        _note_response(p, wa, wg, sh * lo, grav, summary)
-        _note_response(p, wa, wg, sh * hi, grav, summary)
         return
     fx_lo, fx_hi, Fx_lo, Fx_hi, G_lo, G_hi, r_lo, r_hi = _extremes_with_vertical(
         ax, ay, sh, sv, grav, wa[I_FX], wg[I_FX], wa[I_SFX], wg[I_SFX], k0 + 1, last + 1)
