@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -255,6 +256,14 @@ class ShipBlockSystem:
         p[P_E] = self.effective_restitution
         p[P_RULE] = IMPACT_RULES.index(self.impact_rule)
         p[P_G] = self.g
+        return p
+
+    @cached_property
+    def kernel_parameters(self) -> np.ndarray:
+        """:meth:`to_parameter_vector`, made once per system and read-only: the batch entry
+        point takes it at every call, which for a short batch costs as much as a few runs."""
+        p = self.to_parameter_vector()
+        p.flags.writeable = False
         return p
 
     @classmethod

@@ -192,3 +192,26 @@ def test_peaks_over_rest_are_those_of_the_samples_exactly(vertical):
         assert res.summary[name] == pytest.approx(value, rel=1e-12), name
     if vertical:  # the largest friction and the largest utilisation at different samples
         assert np.argmax(np.abs(f.ground_friction)) != np.argmax(f.ground_utilisation)
+
+
+@pytest.mark.parametrize(("system", "level"), [
+    (SYSTEM.replace(mu_s_ship=0.1, mu_k_ship=0.08), 0.3),  # the ship slides on the blocks
+    (SYSTEM.replace(mu_s_ground=0.12, mu_k_ground=0.1, mu_s_ship=0.9, mu_k_ship=0.85), 0.3),
+])
+def test_stick_slip_peaks_from_the_span_extremes_equal_a_scan_of_every_sample(system, level):
+    """Without a vertical input the closed-form spans note the loads from the least and
+    greatest input over each span (the forces are monotone in it); with a vertical input of
+    zeros (the same motion) every sample is scanned. The peaks agree to rounding, through
+    hundreds of slip starts and stops."""
+    rng = np.random.default_rng(11)
+    ax = level * G * np.convolve(rng.normal(size=4000), np.ones(8) / 8, mode="same")
+    folded = simulate(system, ax, None, DT)
+    scanned = simulate(system, ax, np.zeros_like(ax), DT)
+    assert len(folded.events) > 100
+    assert not folded.summary["uplift"]
+    np.testing.assert_array_equal(folded.mode, scanned.mode)
+    for name in LOAD_FIELDS:
+        assert folded.summary[name] == pytest.approx(scanned.summary[name], rel=1e-13, abs=0.0), name
+    # the slip starts: the friction utilisation of the interface that slips reaches its static limit
+    slipping = "ship" if system.mu_s_ship < system.mu_s_ground else "ground"
+    assert folded.summary[f"peak_{slipping}_friction_utilisation"] == pytest.approx(1.0, rel=1e-6)

@@ -298,8 +298,9 @@ def test_random_painleve_states():
         system, y, a, ay = _painleve_state(rng)
         p = system.to_parameter_vector()
         y0 = y.copy()
-        status, loss, jammed, _ = K.resolve_mode(p, y, ms, a, ay, a, ay, -1, w7, np.zeros(N_SPAN_WORK),
-                                                 Kw)
+        work = np.zeros(N_SPAN_WORK)
+        first = K.select_mode(p, y, ms, a, ay, -1, w7, work)
+        status, loss, jammed, _ = K.resolve_mode(p, y, ms, a, ay, a, ay, -1, w7, work, Kw, first)
         if not jammed:
             continue
         assert status in (0, 2)

@@ -67,6 +67,12 @@ PER_BLOCK_FIELDS = ("peak_ground_normal_force", "peak_ground_friction_force",
                     "peak_ship_normal_force", "peak_ship_friction_force", "peak_corner_load")
 
 
+#: The rows of the kernel's summaries that simulate_batch returns, by name.
+_OUTPUT_ROWS = (*SUMMARY_FIELDS.items(),
+                *((name, K.S_MODE_TIME + m) for m, name in enumerate(MODE_TIME_FIELDS)))
+_PER_BLOCK_ROWS = np.array([SUMMARY_FIELDS[name] for name in PER_BLOCK_FIELDS])
+
+
 def _is_motion(value) -> bool:
     """Whether ``value`` is a :class:`shipblock.motion.GroundMotion` (without importing obspy)."""
     return all(hasattr(value, a) for a in ("horizontal", "vertical", "dt"))
@@ -295,6 +301,9 @@ def _case_columns(cases, packed: RecordSet, n_systems: int):
                         f"cases[{row}, {col}] ({what} index) is {idx[col, row]}: out of range, "
                         f"with {n} {what}{'s' if n != 1 else ''}")
         limit = checks.MAX_ACCELERATION * (1.0 + 1e-12)  # a record scaled to exactly 100 g runs
+        top_h, top_v = np.abs(columns[2:]).max(axis=1).tolist()
+        if top_h * packed.top_h <= limit and top_v * packed.top_v <= limit:
+            return idx[0], idx[1], columns[2], columns[3]  # no record can be scaled above it
         for col, peaks, what in ((2, packed.peak_h, "horizontal"), (3, packed.peak_v, "vertical")):
             scaled = np.abs(columns[col]) * peaks[idx[0]]
             if not (scaled <= limit).all():
@@ -375,7 +384,8 @@ def simulate_batch(
         if not isinstance(s, ShipBlockSystem):
             raise ParameterTypeError(f"systems[{i}] must be a ShipBlockSystem, got "
                                      f"{type(s).__name__}")
-    params = np.array([s.to_parameter_vector() for s in systems])
+    params = (systems[0].kernel_parameters[None, :] if len(systems) == 1
+              else np.array([s.kernel_parameters for s in systems]))
     rtol, atol, zeno_omega = check_options(rtol, atol, zeno_omega)
     if isinstance(records, RecordSet):
         if dts is not None:
@@ -395,18 +405,23 @@ def simulate_batch(
     args = (params, packed.acc_h, packed.acc_v, packed.offsets, packed.dts, packed.has_v, rec_idx,
             par_idx, scale_h, scale_v, rtol, atol, zeno_omega, np.zeros(1, dtype=np.int64), summaries,
             False, *K.no_histories(), np.zeros(6))
-    n_samples = float(np.diff(packed.offsets)[rec_idx].sum()) if rec_idx.size else 0.0
-    run_on_threads(K.run_cases, args, batch_threads(numba.get_num_threads(), rec_idx.size, n_samples))
+    requested = numba.get_num_threads()
+    n_threads = 1
+    if requested > 1 and rec_idx.size > 1:
+        n_samples = float(np.diff(packed.offsets)[rec_idx].sum())
+        n_threads = batch_threads(requested, rec_idx.size, n_samples)
+    run_on_threads(K.run_cases, args, n_threads)
     # one field per row, each row contiguous: the arrays returned are views of one block
+    # (rows taken by iteration and the per-block totals divided in place: for a short batch
+    # these steps would otherwise cost as much as some of its runs)
     by_field = np.ascontiguousarray(summaries.T)
-    out = {name: by_field[i] for name, i in SUMMARY_FIELDS.items()}
-    for m, name in enumerate(MODE_TIME_FIELDS):
-        out[name] = by_field[K.S_MODE_TIME + m]
-    thc = params[par_idx, P_THC]
-    out["peak_rotation_ratio"] = out["peak_rotation"] / thc
-    n_blocks = np.array([s.n_blocks for s in systems], dtype=float)[par_idx]
-    for name in PER_BLOCK_FIELDS:
-        out[name] = out[name] / n_blocks
+    if len(systems) == 1:
+        by_field[_PER_BLOCK_ROWS] /= float(systems[0].n_blocks)
+    else:
+        by_field[_PER_BLOCK_ROWS] /= np.array([s.n_blocks for s in systems], dtype=float)[par_idx]
+    rows = list(by_field)
+    out = {name: rows[i] for name, i in _OUTPUT_ROWS}
+    out["peak_rotation_ratio"] = out["peak_rotation"] / params[par_idx, P_THC]
     return out
 
 

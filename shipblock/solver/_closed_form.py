@@ -90,6 +90,7 @@ from shipblock.solver._load_peaks import (
     cached_quiet_interval,
     folds_loads,
     note_mode_loads,
+    note_span_extremes,
     quiet_interval,
 )
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
@@ -98,7 +99,7 @@ NO_ROOT = math.inf
 #: Samples screened at once at rest (see :func:`skip_rest`).
 REST_BLOCK = 32
 #: Samples of a rest phase screened one by one before :func:`skip_rest` takes over.
-REST_FIRST = 32
+REST_FIRST = 64
 #: Samples checked at once against the interval of :func:`held_interval`: a loop of 32 so
 #: short would be unrolled whole and not vectorised.
 FAST_BLOCK = 64
@@ -630,8 +631,9 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
     inv_w, inv_ws, inv_wr = work[W_INV_W], work[W_INV_WS], work[W_INV_WR]
     mode = MODE_NUMBER[slip1, 0, slip2]
     loads = folds_loads(has_ay, fy_a, Fy_a)
-    q_lo, q_hi = cached_quiet_interval(p, work, slot, grav, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g,
-                                       summary) if loads else (1.0, -1.0)
+    # the least and greatest scaled horizontal input over the points the span passes (its
+    # start, its samples, its end): the forces are linear in it, so their peaks are at these two
+    a_lo = a_hi = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)[0] if loads else 0.0
     all_armed = True
     for e in range(N_EVENTS):
         if not armed[e]:
@@ -647,21 +649,25 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
                     ax[k + 1], ay[k + 1], has_ay, sh, sv, grav, fx_a, fx_g, fy_a, fy_g, Fx_a,
                     Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)):
             a1 = sh * ax[k + 1]
-            if loads and not q_lo <= a1 <= q_hi:
-                note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, a1,
-                                grav + 0.0, summary)
-                q_lo, q_hi = cached_quiet_interval(p, work, slot, grav, fx_a, fx_g, fy_g, Fx_a,
-                                                   Fx_g, Fy_g, summary)
+            a_lo = min(a_lo, a1)
+            a_hi = max(a_hi, a1)
             time_in_mode += dt - tau
             tau = 0.0
             k += 1
         if k - k_first == REST_FIRST:
+            if loads:
+                # the extremes so far first: skip_rest passes samples by the quiet interval
+                # of the peaks they raise
+                note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, a_lo, a_hi, grav,
+                                   summary)
+                q_lo, q_hi = cached_quiet_interval(p, work, slot, grav, fx_a, fx_g, fy_g, Fx_a,
+                                                   Fx_g, Fy_g, summary)
+            else:
+                q_lo, q_hi = 1.0, -1.0
             k, time_in_mode = skip_rest(ax, ay, has_ay, sh, sv, k, dt, time_in_mode, grav, fx_a,
                                         fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B,
                                         H, lo, hi, p, loads, q_lo, q_hi, summary)
-            if loads:
-                q_lo, q_hi = cached_quiet_interval(p, work, slot, grav, fx_a, fx_g, fy_g, Fx_a,
-                                                   Fx_g, Fy_g, summary)
+            a_lo = a_hi = sh * ax[k]  # skip_rest noted the samples before it
         if store and k > k_first:
             _store_rest(p, y, hist, modes, k_first + 1, k + 1, mode)
     a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # start of the interval
@@ -736,9 +742,13 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
             if best_e >= 0:
                 # advance to the event: the same polynomials, cut at best_h (u = best_h / h)
                 u = best_h / h
+                a_end = a0 + (a1 - a0) * u
                 exact_update(y, best_h, ub0, ub0 + (ub1 - ub0) * u, us0, us0 + (us1 - us0) * u,
-                             a0, a0 + (a1 - a0) * u, fx0, fx0 + (fx1 - fx0) * u, Fx0,
+                             a0, a_end, fx0, fx0 + (fx1 - fx0) * u, Fx0,
                              Fx0 + (Fx1 - Fx0) * u, mass_b, M)
+                if loads:
+                    note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, min(a_lo, a_end),
+                                       max(a_hi, a_end), grav, summary)
                 return k, tau + best_h, best_e, time_in_mode + best_h, peak_xb, peak_xs
         # no event: advance exactly to the next sample
         moving_b = slip1 or vb0 != 0.0
@@ -760,11 +770,8 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         time_in_mode += h
         k += 1
         tau = 0.0
-        if loads and not q_lo <= a1 <= q_hi:
-            # the sample reached (G1 = g + 0.0 without a vertical input)
-            note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, a1, G1, summary)
-            q_lo, q_hi = cached_quiet_interval(p, work, slot, grav, fx_a, fx_g, fy_g, Fx_a, Fx_g,
-                                               Fy_g, summary)
+        a_lo = min(a_lo, a1)
+        a_hi = max(a_hi, a1)
         # the end of this interval is the start of the next: the same values, not recomputed
         a0 = a1
         G0 = G1
@@ -774,6 +781,8 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
             all_armed = rearm(armed, g)
         if store:
             store_sample(p, ms, y, hist, modes, k, mode)
+    if loads:
+        note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, a_lo, a_hi, grav, summary)
     return k, tau, -1, time_in_mode, peak_xb, peak_xs
 
 

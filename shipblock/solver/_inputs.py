@@ -54,6 +54,10 @@ def check_dt(dt, name: str = "dt") -> float:
 
 def check_options(rtol, atol, zeno_omega) -> tuple[float, float, float]:
     """The solver tolerances as floats, each checked against its range (named in the error)."""
+    if (type(rtol) is float and type(atol) is float and type(zeno_omega) is float
+            and RTOL_RANGE[0] <= rtol < RTOL_RANGE[1] and ATOL_RANGE[0] <= atol <= ATOL_RANGE[1]
+            and 0.0 <= zeno_omega <= MAX_ZENO_OMEGA):
+        return rtol, atol, zeno_omega  # the usual case (NaN fails a comparison, and goes below)
     return (
         checks.real(rtol, "rtol", low=RTOL_RANGE[0], high=RTOL_RANGE[1], high_open=True),
         checks.real(atol, "atol", low=ATOL_RANGE[0], high=ATOL_RANGE[1]),
@@ -199,6 +203,9 @@ class RecordSet:
         self.dts = dts_arr
         self.has_v = has_v
         self.peak_h, self.peak_v = peak_h, peak_v
+        # the largest peaks (0.0 with no records): a bound on every scaled record's
+        self.top_h = float(peak_h.max(initial=0.0))
+        self.top_v = float(peak_v.max(initial=0.0))
 
     def __len__(self) -> int:
         return self.dts.size

@@ -645,8 +645,13 @@ def ship_lifts_off(p, y, a, G, w7):
 
 
 @njit(cache=True, forceinline=False, _nrt=False)
-def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K):
-    """:func:`select_mode`, with a jam of a slipping interface when no mode is consistent.
+def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K, status):
+    """What follows :func:`select_mode` at ``(a, b)`` when it chose no mode: a jam of a slipping
+    interface when no mode is consistent.
+
+    ``status`` is the selection's result. The kernel makes the selection itself and calls this
+    only when it was not 0 (so the usual event costs one call and one ground input, and the
+    later input ``(a_wide, b_wide)`` is taken only here).
 
     When the selection finds no consistent mode and no separation, the state is in the
     Painleve regime: a slipping interface's friction makes the effective inertia of the
@@ -668,8 +673,8 @@ def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K):
     Returns
     -------
     status : int
-        0 a consistent mode (in ``ms``), 2 separation, 1 no trial helped (the velocities are
-        then those before the jam).
+        0 a consistent mode (in ``ms``; also for a ``status`` of 0 given), 2 separation, 1 no
+        trial helped (the velocities are then those before the jam).
     loss : float
         Kinetic energy lost in the jam [J] (0 without one).
     jammed : int
@@ -677,7 +682,8 @@ def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K):
     jam_from : int
         Mode number of the motions at the event (the interfaces moving before a jam).
     """
-    status = select_mode(p, y, ms, a, b, trigger, w7, work)
+    if status == 0:
+        return 0, 0.0, 0, mode_number(ms)
     if status == 1 and select_mode(p, y, ms, a_wide, b_wide, trigger, w7, work) == 0:
         return 0, 0.0, 0, mode_number(ms)
     vb, om, vs = y[Y_VB], y[Y_OM], y[Y_VS]
@@ -836,8 +842,9 @@ summary, y_init
     tau = 0.0
     a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, k, ONE_SIDED_DT, dt)
     a_wide, b_wide = ground_motion_at(ax, ay, has_ay, sh, sv, k, ONE_SIDED_WIDE, dt)
-    status, jam_loss, jammed, jam_from = resolve_mode(p_vec, y, ms, a_next, b_next, a_wide,
-                                                      b_wide, np.int64(-1), w7, span_work, K)
+    status, jam_loss, jammed, jam_from = resolve_mode(
+        p_vec, y, ms, a_next, b_next, a_wide, b_wide, np.int64(-1), w7, span_work, K,
+        select_mode(p_vec, y, ms, a_next, b_next, np.int64(-1), w7, span_work))
     if status == 2:
         failure = Failure.SEPARATION
         failure_time = 0.0
@@ -1091,10 +1098,14 @@ summary, y_init
                 old0, old1, old2, old3, old4, old5 = ms[0], ms[1], ms[2], ms[3], ms[4], ms[5]
                 a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + ONE_SIDED_DT,
                                                   dt)
-                a_wide, b_wide = ground_motion_at(ax, ay, has_ay, sh, sv, k,
-                                                  tau + ONE_SIDED_WIDE, dt)
-                status, jam_loss, jammed, jam_from = resolve_mode(
-                    p_vec, y, ms, a_next, b_next, a_wide, b_wide, trigger, w7, span_work, K)
+                status = select_mode(p_vec, y, ms, a_next, b_next, trigger, w7, span_work)
+                jam_loss = 0.0
+                if status != 0:
+                    a_wide, b_wide = ground_motion_at(ax, ay, has_ay, sh, sv, k,
+                                                      tau + ONE_SIDED_WIDE, dt)
+                    status, jam_loss, jammed, jam_from = resolve_mode(
+                        p_vec, y, ms, a_next, b_next, a_wide, b_wide, trigger, w7, span_work, K,
+                        status)
                 if jammed:
                     # the jam's loss is booked with the impacts' (a tangential impact)
                     n_jams += 1

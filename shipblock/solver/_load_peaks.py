@@ -179,16 +179,20 @@ def cached_quiet_interval(p, work, slot, grav, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_
 
 
 @njit(cache=True, forceinline=True)
-def note_quiet_end(p, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, a, G, q_lo, q_hi, summary):
-    """:func:`note_mode_loads` at an end of a span whose samples the span noted itself
-    (``fy_a = Fy_a = 0``, ``G = g``): inside ``[q_lo, q_hi]`` only the normal forces, which
-    do not depend on ``a``, can raise a peak, and only they are compared."""
-    if q_lo <= a <= q_hi:
-        fy = fy_g * G
-        Fy = Fy_g * G
-        if fy > summary[S_PEAK_FY]:
-            summary[S_PEAK_FY] = fy
-        if Fy > summary[S_PEAK_SFY]:
-            summary[S_PEAK_SFY] = Fy
-    else:
-        note_mode_loads(p, fx_a, fx_g, 0.0, fy_g, Fx_a, Fx_g, 0.0, Fy_g, a, G, summary)
+def note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, a_lo, a_hi, G, summary):
+    """:func:`note_mode_loads` of a non-rocking mode whose normal forces do not depend on ``a``
+    (:func:`folds_loads`) over a span whose scaled horizontal input [m/s^2] ranged over
+    ``[a_lo, a_hi]`` at its samples and ends (``G = g``): the peaks of noting every one of them,
+    to the bit.
+
+    Each force ``s a + q`` is computed with one rounding per operation, each monotone, so it is
+    monotone in ``a`` as computed; its magnitude, and its utilisation (its magnitude over a
+    fixed ``mu fy``), are greatest at one of the two ends of the range.
+    """
+    base = W_QUIET + N_QUIET * slot
+    if (work[base + 6] == 1.0 and work[base] <= a_lo and a_hi <= work[base + 1]
+            and fy_g * G <= summary[S_PEAK_FY] and Fy_g * G <= summary[S_PEAK_SFY]):
+        return  # inside the quiet interval kept for the mode (peaks since risen only widen it)
+    note_mode_loads(p, fx_a, fx_g, 0.0, fy_g, Fx_a, Fx_g, 0.0, Fy_g, a_lo, G, summary)
+    note_mode_loads(p, fx_a, fx_g, 0.0, fy_g, Fx_a, Fx_g, 0.0, Fy_g, a_hi, G, summary)
+    cached_quiet_interval(p, work, slot, G, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, summary)

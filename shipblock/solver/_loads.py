@@ -31,7 +31,7 @@ import math
 from numba import njit
 
 from shipblock.equations import I_FX, I_FY, I_SFX, I_SFY, N_SOLVE_OUT, solve_mode
-from shipblock.solver._closed_form import mode_response_start, response_slot
+from shipblock.solver._closed_form import mode_response_start
 from shipblock.solver._ground import ground_motion_at
 from shipblock.solver._layout import (
     MS_ROCK,
@@ -46,10 +46,8 @@ from shipblock.solver._layout import (
     Y_TH,
 )
 from shipblock.solver._load_peaks import (
-    cached_quiet_interval,
     folds_loads,
     note_loads,
-    note_quiet_end,
 )
 from shipblock.system import P_G, P_MUS1, P_MUS2
 
@@ -136,19 +134,7 @@ def span_loads(p, ms, work, ax, ay, has_ay, sh, sv, dt, k0, tau0, k1, tau1, summ
     wg = work[start + N_SOLVE_OUT:start + 2 * N_SOLVE_OUT]
     grav = p[P_G]
     if folds_loads(has_ay, wa[I_FY], wa[I_SFY]):
-        # the span noted its samples' loads itself; an end inside the quiet interval can only
-        # raise the normal forces' peaks
-        q_lo, q_hi = cached_quiet_interval(
-            p, work, response_slot(ms[MS_SLIP1], float(ms[MS_SIG1]), ms[MS_SLIP2],
-                                   float(ms[MS_SIG2])),
-            grav, wa[I_FX], wg[I_FX], wg[I_FY], wa[I_SFX], wg[I_SFX], wg[I_SFY], summary)
-        a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k0, tau0, dt)
-        note_quiet_end(p, wa[I_FX], wg[I_FX], wg[I_FY], wa[I_SFX], wg[I_SFX], wg[I_SFY], a,
-                       grav + b, q_lo, q_hi, summary)
-        a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k1, tau1, dt)
-        note_quiet_end(p, wa[I_FX], wg[I_FX], wg[I_FY], wa[I_SFX], wg[I_SFX], wg[I_SFY], a,
-                       grav + b, q_lo, q_hi, summary)
-        return
+        return  # the span noted its own loads, ends included
     a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k0, tau0, dt)
     _note_response(p, wa, wg, a, grav + b, summary)
     a, b = ground_motion_at(ax, ay, has_ay, sh, sv, k1, tau1, dt)
