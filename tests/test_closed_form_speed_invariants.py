@@ -18,8 +18,17 @@ from shipblock.solver._closed_form import (
     skip_rest,
     slip_may_stop,
 )
-from shipblock.solver._layout import N_SUMMARY, S_PEAK_FX, S_PEAK_SFX, S_PEAK_UTIL_G, S_PEAK_UTIL_S, parameter_tuple
-from shipblock.solver._load_peaks import quiet_interval
+from shipblock.solver._layout import (
+    N_SPAN_WORK,
+    N_SUMMARY,
+    S_PEAK_FX,
+    S_PEAK_SFX,
+    S_PEAK_UTIL_G,
+    S_PEAK_UTIL_S,
+    W_NOTED,
+    parameter_tuple,
+)
+from shipblock.solver._load_peaks import note_span_extremes
 from shipblock.system import P_B, P_G, P_H, P_MUS1, P_MUS2
 
 
@@ -97,11 +106,9 @@ def test_rest_blocks_skip_exactly_the_passing_samples(has_ay, fast):
     for j in range(n):
         assert rest_breaks(ax[j], ay[j], has_ay, sh, sv, *c) == breaks[j]
     lo, hi = held_interval(0, 0, *c) if fast and not has_ay else (1.0, -1.0)
-    p = system.to_parameter_vector()
-    summary = np.zeros(N_SUMMARY)
     for k0 in list(rng.choice(n - 1, 60, replace=False)) + [0, n - 40, n - 2]:
-        k, time = skip_rest(ax, ay, has_ay, sh, sv, int(k0), dt, 0.25, *c, lo, hi, p,
-                            np.bool_(False), 1.0, -1.0, summary)
+        k, time, _, _ = skip_rest(ax, ay, has_ay, sh, sv, int(k0), dt, 0.25, *c, lo, hi,
+                                  np.bool_(False), 0.0, 0.0, np.inf, -np.inf)
         assert k0 <= k <= n - 1
         assert not breaks[k0 + 1:k + 1].any()  # nothing skipped that the screen would stop at
         assert k == n - 1 or breaks[k + 1]  # stops at the first break
@@ -122,12 +129,14 @@ def direct_rest_peaks(p, c, a_values):
 
 
 @pytest.mark.parametrize("seed", [3, 4])
-def test_rest_blocks_note_the_loads_of_every_sample_they_pass(seed):
-    """skip_rest with loads: the peaks over the samples passed are those of noting each one,
-    to the bit, though most blocks are passed by the two comparisons of the quiet interval;
-    and the break found is the one found without loads."""
+def test_rest_blocks_keep_the_range_whose_loads_equal_those_of_every_sample(seed):
+    """skip_rest with loads keeps the range of the scaled input over the samples it passes;
+    noting the loads at its ends (note_span_extremes, with the range already noted per mode)
+    gives the peaks of noting every sample passed, to the bit, though most blocks are passed
+    by two comparisons a sample; and the break found is the one found without loads."""
     system = ShipBlockSystem.example()
     c = rest_coefficients(system)
+    grav, fx_a, fx_g, _, fy_g, Fx_a, Fx_g, _, Fy_g = c[:9]
     p = system.to_parameter_vector()
     rng = np.random.default_rng(seed)
     n, dt, sh = 20000, 0.005, 1.3
@@ -140,17 +149,23 @@ def test_rest_blocks_note_the_loads_of_every_sample_they_pass(seed):
     assert lo < hi
     k = 0
     summary = np.zeros(N_SUMMARY)
+    work = np.zeros(N_SPAN_WORK)
+    work[W_NOTED], work[W_NOTED + 1] = np.inf, -np.inf  # slot 0: rest, nothing noted yet
     passed = np.zeros(n, dtype=bool)
-    n_spans = 0
+    n_spans = n_widened = 0
     while k < n - 1:
         k0 = k
-        k_plain, _ = skip_rest(ax, ay, False, sh, 0.0, k0, dt, 0.0, *c, lo, hi, p,
-                               np.bool_(False), 1.0, -1.0, np.zeros(N_SUMMARY))
-        q_lo, q_hi = quiet_interval(p, c[0], c[1], c[2], c[4], c[5], c[6], c[8], summary)
-        k, _ = skip_rest(ax, ay, False, sh, 0.0, k0, dt, 0.0, *c, lo, hi, p, np.bool_(True),
-                         q_lo, q_hi, summary)
+        k_plain, _, _, _ = skip_rest(ax, ay, False, sh, 0.0, k0, dt, 0.0, *c, lo, hi,
+                                     np.bool_(False), 0.0, 0.0, np.inf, -np.inf)
+        noted = (work[W_NOTED], work[W_NOTED + 1])
+        # (an empty range to start with: k0 is the break passed over, not at rest)
+        k, _, a_lo, a_hi = skip_rest(ax, ay, False, sh, 0.0, k0, dt, 0.0, *c, lo, hi,
+                                     np.bool_(True), np.inf, -np.inf, *noted)
         assert k == k_plain
         passed[k0 + 1:k + 1] = True
+        note_span_extremes(p, work, 0, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, a_lo, a_hi, grav,
+                           summary)
+        n_widened += (work[W_NOTED], work[W_NOTED + 1]) != noted
         if passed.any():
             want = direct_rest_peaks(p, c, sh * ax[passed])  # every sample passed so far
             got = (summary[S_PEAK_FX], summary[S_PEAK_SFX], summary[S_PEAK_UTIL_G],
@@ -159,7 +174,8 @@ def test_rest_blocks_note_the_loads_of_every_sample_they_pass(seed):
         n_spans += 1
         k += 1  # over the break
     assert n_spans > 5
-    # the peaks grew through the record: the quiet interval was recomputed, not just kept
+    # the peaks grew through the record: the noted range widened again and again
+    assert n_widened > 3
     assert 0.3 < summary[S_PEAK_UTIL_G] < 1.0
 
 

@@ -72,11 +72,13 @@ from shipblock.solver._layout import (
     N_EVENTS,
     N_STATE,
     ROOT_TIME_TOL,
+    W_FOLDED,
     W_G,
     W_HELD,
     W_INV_W,
     W_INV_WR,
     W_INV_WS,
+    W_NOTED,
     W_RESP,
     W_RESP_STATE,
     Y_DIS,
@@ -87,11 +89,8 @@ from shipblock.solver._layout import (
     Y_XS,
 )
 from shipblock.solver._load_peaks import (
-    cached_quiet_interval,
     folds_loads,
-    note_mode_loads,
     note_span_extremes,
-    quiet_interval,
 )
 from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
@@ -192,13 +191,24 @@ def slip_may_stop(sig, v0, u0, u1, h):
 @njit(cache=True, error_model="numpy", forceinline=True)
 def exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M):
     """Advance ``y`` by ``h`` with slip accelerations, ground acceleration and friction forces
-    linear in time from their values at 0 (``*0``) to those at ``h`` (``*1``).
+    linear in time from their values at 0 (``*0``) to those at ``h`` (``*1``): :func:`exact_step`
+    on the state's entries."""
+    y[Y_XB], y[Y_VB], y[Y_XS], y[Y_VS], y[Y_WIN], y[Y_DIS] = exact_step(
+        y[Y_XB], y[Y_VB], y[Y_XS], y[Y_VS], y[Y_WIN], y[Y_DIS], h, ub0, ub1, us0, us1, a0, a1,
+        fx0, fx1, Fx0, Fx1, mass_b, M)
+
+
+@njit(cache=True, error_model="numpy", forceinline=True)
+def exact_step(xb, vb0, xs, vs0, w_in, dis, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1,
+               mass_b, M):
+    """Slips, slip velocities, input work and dissipation (``xb, vb0, xs, vs0, w_in, dis``)
+    advanced by ``h`` with slip accelerations, ground acceleration and friction forces linear in
+    time from their values at 0 (``*0``) to those at ``h`` (``*1``).
 
     Velocities are quadratic and slips cubic in time; the input power -a P_x and the friction
     dissipation rate -(fx v_b + Fx v_s) are cubic, so Simpson's rule integrates them exactly.
+    Values in and out (rather than the state array) let the span's loop keep them in registers.
     """
-    vb0 = y[Y_VB]
-    vs0 = y[Y_VS]
     vb1 = vb0 + 0.5 * h * (ub0 + ub1)
     vs1 = vs0 + 0.5 * h * (us0 + us1)
     vbm = vb0 + 0.5 * h * ub0 + 0.125 * h * (ub1 - ub0)
@@ -210,23 +220,19 @@ def exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M
     d0 = -(fx0 * vb0 + Fx0 * vs0)
     dm = -(0.5 * (fx0 + fx1) * vbm + 0.5 * (Fx0 + Fx1) * vsm)
     d1 = -(fx1 * vb1 + Fx1 * vs1)
-    y[Y_XB] += h * vb0 + h * h * (2.0 * ub0 + ub1) / 6.0
-    y[Y_XS] += h * vs0 + h * h * (2.0 * us0 + us1) / 6.0
-    y[Y_VB] = vb1
-    y[Y_VS] = vs1
-    y[Y_WIN] += h * (r0 + 4.0 * rm + r1) / 6.0
-    y[Y_DIS] += h * (d0 + 4.0 * dm + d1) / 6.0
+    return (xb + (h * vb0 + h * h * (2.0 * ub0 + ub1) / 6.0), vb1,
+            xs + (h * vs0 + h * h * (2.0 * us0 + us1) / 6.0), vs1,
+            w_in + h * (r0 + 4.0 * rm + r1) / 6.0, dis + h * (d0 + 4.0 * dm + d1) / 6.0)
 
 
 @njit(cache=True, error_model="numpy", forceinline=True)
-def exact_update_one(y, ix, iv, h, u0, u1, a0, a1, f0, f1, m):
-    """As :func:`exact_update` when only one interface moves: slip ``y[ix]``, slip velocity
-    ``y[iv]``, its acceleration ``u``, friction force ``f`` and the mass ``m`` it carries.
+def exact_step_one(x, v0, w_in, dis, h, u0, u1, a0, a1, f0, f1, m):
+    """As :func:`exact_step` when only one interface moves: its slip ``x``, slip velocity
+    ``v0``, acceleration ``u``, friction force ``f`` and the mass ``m`` it carries.
 
     The other interface's terms are products with its zero velocity and acceleration, so
     leaving them out gives the same values with half the arithmetic.
     """
-    v0 = y[iv]
     v1 = v0 + 0.5 * h * (u0 + u1)
     vm = v0 + 0.5 * h * u0 + 0.125 * h * (u1 - u0)
     am = 0.5 * (a0 + a1)
@@ -236,10 +242,8 @@ def exact_update_one(y, ix, iv, h, u0, u1, a0, a1, f0, f1, m):
     d0 = -(f0 * v0)
     dm = -(0.5 * (f0 + f1) * vm)
     d1 = -(f1 * v1)
-    y[ix] += h * v0 + h * h * (2.0 * u0 + u1) / 6.0
-    y[iv] = v1
-    y[Y_WIN] += h * (r0 + 4.0 * rm + r1) / 6.0
-    y[Y_DIS] += h * (d0 + 4.0 * dm + d1) / 6.0
+    return (x + (h * v0 + h * h * (2.0 * u0 + u1) / 6.0), v1,
+            w_in + h * (r0 + 4.0 * rm + r1) / 6.0, dis + h * (d0 + 4.0 * dm + d1) / 6.0)
 
 
 @njit(cache=True, error_model="numpy", forceinline=True)
@@ -374,7 +378,7 @@ def add_repeated(t, dt, n):
 
 @njit(cache=True, forceinline=False, error_model="numpy", _nrt=False)
 def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g,
-              Fy_a, Fy_g, mus1, mus2, B, H, lo, hi, p, loads, q_lo, q_hi, summary):
+              Fy_a, Fy_g, mus1, mus2, B, H, lo, hi, loads, a_lo, a_hi, n_lo, n_hi):
     """Advance rest from sample ``k`` to the first interval that fails the screen (see
     :func:`rest_breaks`), or to the end of the record.
 
@@ -384,12 +388,12 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
     else ``REST_BLOCK`` by the screen itself, the first failing interval found by a minimum
     over the block's indices. The time is added at the end (:func:`add_repeated`).
 
-    With ``loads`` the contact loads of the samples passed are noted on the way
-    (:mod:`~shipblock.solver._load_peaks`): the fast blocks are checked against the
-    intersection of ``[lo, hi]`` with the :func:`~shipblock.solver._load_peaks.quiet_interval`
-    of rest, and a block that fails only the latter is counted again against ``[lo, hi]`` and
-    its samples outside the quiet interval noted; the samples screened one by one or by
-    ``REST_BLOCK`` are noted if outside it. The break found is the same either way.
+    With ``loads`` the range of the scaled input over the samples passed is kept too, for
+    :func:`~shipblock.solver._load_peaks.note_span_extremes`: the fast blocks are checked
+    against ``[lo, hi]`` cut to the range already covered (the span's ``[a_lo, a_hi]`` and the
+    range ``[n_lo, n_hi]`` whose loads are noted: their hull, whose ends are all noted by the
+    end of the span), and only a block that reaches beyond it is scanned for its least and
+    greatest input, once. The break found is the same either way.
 
     Parameters
     ----------
@@ -404,16 +408,13 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
     lo, hi : float
         Scaled horizontal accelerations at which rest surely passes the screen
         (:func:`held_interval` of rest; ``lo > hi`` for none, as with a vertical input).
-    p : ndarray
-        Parameter vector (for the friction coefficients of the loads).
     loads : bool
-        Whether to note the loads of the samples passed (only where
+        Whether to keep the range of the input (only where
         :func:`~shipblock.solver._load_peaks.folds_loads`: no vertical input).
-    q_lo, q_hi : float
-        The :func:`~shipblock.solver._load_peaks.quiet_interval` of rest at the call (if
-        ``loads``).
-    summary : ndarray
-        The run's summary, whose load peaks are raised.
+    a_lo, a_hi : float
+        The span's range of scaled input so far [m/s^2].
+    n_lo, n_hi : float
+        The range whose loads are noted (``inf, -inf`` for none).
 
     Returns
     -------
@@ -421,13 +422,16 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
         The sample whose interval fails the screen (``n - 1`` at the end of the record).
     time : float
         The time in the mode, with ``dt`` added interval by interval as the span adds it.
+    a_lo, a_hi : float
+        The span's range, with the samples passed.
     """
     n = ax.shape[0]
     k0 = k
-    # the loads: samples in [q_lo, q_hi] raise no peak; the fast blocks check [f_lo, f_hi]
-    if not loads:
-        q_lo, q_hi = -math.inf, math.inf
-    f_lo, f_hi = max(lo, q_lo), min(hi, q_hi)
+    # a fast block inside [f_lo, f_hi] holds rest and raises no peak beyond the covered range
+    if loads:
+        f_lo, f_hi = max(lo, min(a_lo, n_lo)), min(hi, max(a_hi, n_hi))
+    else:
+        f_lo, f_hi = lo, hi
     while True:
         if k + REST_BLOCK >= n:
             # the last samples, one by one
@@ -435,9 +439,8 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
                                                  fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a,
                                                  Fy_g, mus1, mus2, B, H):
                 a1 = sh * ax[k + 1]
-                if loads and not q_lo <= a1 <= q_hi:
-                    note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, a1,
-                                    grav + 0.0, summary)
+                a_lo = min(a_lo, a1)
+                a_hi = max(a_hi, a1)
                 k += 1
             break
         # indices from 0 in a slice, so that the loads are contiguous (no negative-index
@@ -449,8 +452,8 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
                 a1 = sh * bx[j]  # as rest_breaks scales it
                 outside += (a1 < f_lo) | (a1 > f_hi)
             if outside != 0 and loads:
-                # a sample may raise a peak: if the block is all rest all the same, its
-                # samples outside the quiet interval are noted and the block passed
+                # beyond the covered range: if the block is all rest all the same, its range
+                # widens the span's
                 outside = 0
                 for j in range(FAST_BLOCK):
                     a1 = sh * bx[j]
@@ -458,12 +461,9 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
                 if outside == 0:
                     for j in range(FAST_BLOCK):
                         a1 = sh * bx[j]
-                        if not q_lo <= a1 <= q_hi:
-                            note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g,
-                                            a1, grav + 0.0, summary)
-                    q_lo, q_hi = quiet_interval(p, grav, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g,
-                                                summary)
-                    f_lo, f_hi = max(lo, q_lo), min(hi, q_hi)
+                        a_lo = min(a_lo, a1)
+                        a_hi = max(a_hi, a1)
+                    f_lo, f_hi = max(lo, min(a_lo, n_lo)), min(hi, max(a_hi, n_hi))
             if outside == 0:
                 k += FAST_BLOCK
                 continue
@@ -475,21 +475,16 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
                               Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
             first = min(first, j if bad else REST_BLOCK)
         if loads:
-            noted = False
             for j in range(first):  # the samples passed
                 a1 = sh * bx[j]
-                if not q_lo <= a1 <= q_hi:
-                    note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, a1,
-                                    grav + 0.0, summary)
-                    noted = True
-            if noted:
-                q_lo, q_hi = quiet_interval(p, grav, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, summary)
-                f_lo, f_hi = max(lo, q_lo), min(hi, q_hi)
+                a_lo = min(a_lo, a1)
+                a_hi = max(a_hi, a1)
+            f_lo, f_hi = max(lo, min(a_lo, n_lo)), min(hi, max(a_hi, n_hi))
         if first < REST_BLOCK:
             k += first
             break
-        k += REST_BLOCK  # not k += first: the next block's loads need not wait for the minimum
-    return k, add_repeated(time, dt, k - k0)
+        k += REST_BLOCK  # not k += first: the next block's range need not wait for the minimum
+    return k, add_repeated(time, dt, k - k0), a_lo, a_hi
 
 
 @njit(cache=True, forceinline=True)
@@ -544,6 +539,9 @@ def mode_response_start(p, work, slip1, sig1, slip2, sig2):
         ok_a = solve_mode(p, slip1, np.int64(0), slip2, 1.0, sig1, sig2, 0.0, 0.0, 1.0, 0.0, wa)
         ok_g = solve_mode(p, slip1, np.int64(0), slip2, 1.0, sig1, sig2, 0.0, 0.0, 0.0, 1.0, wg)
         work[W_RESP_STATE + slot] = 1.0 if ok_a and ok_g else 2.0
+        # no input noted yet for the mode's contact loads (see note_span_extremes)
+        work[W_NOTED + 2 * slot] = math.inf
+        work[W_NOTED + 2 * slot + 1] = -math.inf
         if ok_a and ok_g:
             work[W_HELD + 2 * slot], work[W_HELD + 2 * slot + 1] = held_interval(
                 slip1, slip2, p[P_G], wa[I_FX], wg[I_FX], wa[I_FY], wg[I_FY], wa[I_SFX],
@@ -584,14 +582,16 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         later spans and mode selections in the run (a stick-slip record enters the same few
         modes thousands of times); the inverse weights
         that scale the event functions, set by the first span; per response slot the
-        interval of :func:`held_interval`, set with its response vectors.
+        interval of :func:`held_interval`, set with its response vectors, and the range of
+        input whose contact loads are noted.
     summary : ndarray, shape (N_SUMMARY,)
         The run's summary. Where :func:`~shipblock.solver._load_peaks.folds_loads` (no
-        vertical input), the contact loads of every sample the span passes are noted in its
-        peaks on the way, by the span's own scan: a sample inside the
-        :func:`~shipblock.solver._load_peaks.quiet_interval` is passed by two comparisons,
-        the others are noted. (The span's two ends are noted by
-        :func:`~shipblock.solver._loads.span_loads`, which the kernel calls next.)
+        vertical input), the span notes the contact loads of its start, its samples and its
+        end itself: it keeps the least and greatest scaled input over them (two operations a
+        sample; :func:`skip_rest` keeps them over a long rest) and notes the loads there on
+        leaving (:func:`~shipblock.solver._load_peaks.note_span_extremes`). Otherwise
+        :func:`~shipblock.solver._loads.span_loads`, which the kernel calls next (when
+        ``work[W_FOLDED]`` is 0), scans them.
 
     Returns
     -------
@@ -631,9 +631,11 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
     inv_w, inv_ws, inv_wr = work[W_INV_W], work[W_INV_WS], work[W_INV_WR]
     mode = MODE_NUMBER[slip1, 0, slip2]
     loads = folds_loads(has_ay, fy_a, Fy_a)
+    work[W_FOLDED] = 1.0 if loads else 0.0
     # the least and greatest scaled horizontal input over the points the span passes (its
     # start, its samples, its end): the forces are linear in it, so their peaks are at these two
-    a_lo = a_hi = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)[0] if loads else 0.0
+    a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # the start
+    a_lo = a_hi = a0
     all_armed = True
     for e in range(N_EVENTS):
         if not armed[e]:
@@ -655,27 +657,24 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
             tau = 0.0
             k += 1
         if k - k_first == REST_FIRST:
-            if loads:
-                # the extremes so far first: skip_rest passes samples by the quiet interval
-                # of the peaks they raise
-                note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, a_lo, a_hi, grav,
-                                   summary)
-                q_lo, q_hi = cached_quiet_interval(p, work, slot, grav, fx_a, fx_g, fy_g, Fx_a,
-                                                   Fx_g, Fy_g, summary)
-            else:
-                q_lo, q_hi = 1.0, -1.0
-            k, time_in_mode = skip_rest(ax, ay, has_ay, sh, sv, k, dt, time_in_mode, grav, fx_a,
-                                        fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B,
-                                        H, lo, hi, p, loads, q_lo, q_hi, summary)
-            a_lo = a_hi = sh * ax[k]  # skip_rest noted the samples before it
+            k, time_in_mode, a_lo, a_hi = skip_rest(
+                ax, ay, has_ay, sh, sv, k, dt, time_in_mode, grav, fx_a, fx_g, fy_a, fy_g, Fx_a,
+                Fx_g, Fy_a, Fy_g, mus1, mus2, B, H, lo, hi, loads, a_lo, a_hi,
+                work[W_NOTED + 2 * slot], work[W_NOTED + 2 * slot + 1])
         if store and k > k_first:
             _store_rest(p, y, hist, modes, k_first + 1, k + 1, mode)
-    a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # start of the interval
+    if tau == 0.0:
+        # the start of the interval, at a sample (the rest above may have passed some): as
+        # ground_motion_at gives it there
+        a0 = sh * ax[k]
+        b0 = sv * ay[k] if has_ay else 0.0
     G0 = grav + b0
     fx0 = fx_a * a0 + fx_g * G0
     Fx0 = Fx_a * a0 + Fx_g * G0
     ub0 = ub_a * a0 + ub_g * G0
     us0 = us_a * a0 + us_g * G0
+    # the state that moves, in locals through the loop (in y at every exit and before any use)
+    xb, vb, xs, vs, w_in, dis = y[Y_XB], y[Y_VB], y[Y_XS], y[Y_VS], y[Y_WIN], y[Y_DIS]
     while k < n - 1:
         h = dt - tau
         a1 = sh * ax[k + 1]
@@ -685,8 +684,8 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         Fx1 = Fx_a * a1 + Fx_g * G1
         ub1 = ub_a * a1 + ub_g * G1
         us1 = us_a * a1 + us_g * G1
-        vb0 = y[Y_VB]
-        vs0 = y[Y_VS]
+        vb0 = vb
+        vs0 = vs
         # Cheap screen at the end of the interval: force-type event functions are linear (or
         # concave) in time and can only fire if negative at the end; slip velocities are
         # quadratic and can also dip below zero inside. Only a suspect interval is searched.
@@ -743,6 +742,8 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
                 # advance to the event: the same polynomials, cut at best_h (u = best_h / h)
                 u = best_h / h
                 a_end = a0 + (a1 - a0) * u
+                y[Y_XB], y[Y_XS], y[Y_WIN], y[Y_DIS] = xb, xs, w_in, dis
+                y[Y_VB], y[Y_VS] = vb, vs
                 exact_update(y, best_h, ub0, ub0 + (ub1 - ub0) * u, us0, us0 + (us1 - us0) * u,
                              a0, a_end, fx0, fx0 + (fx1 - fx0) * u, Fx0,
                              Fx0 + (Fx1 - Fx0) * u, mass_b, M)
@@ -755,16 +756,18 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         moving_s = slip2 or vs0 != 0.0
         if moving_b or moving_s:
             if not moving_s:
-                exact_update_one(y, np.int64(Y_XB), np.int64(Y_VB), h, ub0, ub1, a0, a1, fx0, fx1,
-                                 mass_b)
+                xb, vb, w_in, dis = exact_step_one(xb, vb, w_in, dis, h, ub0, ub1, a0, a1, fx0,
+                                                   fx1, mass_b)
             elif not moving_b:
-                exact_update_one(y, np.int64(Y_XS), np.int64(Y_VS), h, us0, us1, a0, a1, Fx0, Fx1, M)
+                xs, vs, w_in, dis = exact_step_one(xs, vs, w_in, dis, h, us0, us1, a0, a1, Fx0,
+                                                   Fx1, M)
             else:
-                exact_update(y, h, ub0, ub1, us0, us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M)
-            axb = abs(y[Y_XB])
+                xb, vb, xs, vs, w_in, dis = exact_step(xb, vb, xs, vs, w_in, dis, h, ub0, ub1, us0,
+                                                       us1, a0, a1, fx0, fx1, Fx0, Fx1, mass_b, M)
+            axb = abs(xb)
             if axb > peak_xb:
                 peak_xb = axb
-            axs = abs(y[Y_XS])
+            axs = abs(xs)
             if axs > peak_xs:
                 peak_xs = axs
         time_in_mode += h
@@ -776,11 +779,15 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         a0 = a1
         G0 = G1
         fx0, Fx0, ub0, us0 = fx1, Fx1, ub1, us1
-        if not all_armed:
-            event_functions(p, ms, y, fx1, fy_a * a1 + fy_g * G1, Fx1, Fy_a * a1 + Fy_g * G1, g)
-            all_armed = rearm(armed, g)
-        if store:
-            store_sample(p, ms, y, hist, modes, k, mode)
+        if not all_armed or store:
+            y[Y_XB], y[Y_VB], y[Y_XS], y[Y_VS], y[Y_WIN], y[Y_DIS] = xb, vb, xs, vs, w_in, dis
+            if not all_armed:
+                event_functions(p, ms, y, fx1, fy_a * a1 + fy_g * G1, Fx1,
+                                Fy_a * a1 + Fy_g * G1, g)
+                all_armed = rearm(armed, g)
+            if store:
+                store_sample(p, ms, y, hist, modes, k, mode)
+    y[Y_XB], y[Y_VB], y[Y_XS], y[Y_VS], y[Y_WIN], y[Y_DIS] = xb, vb, xs, vs, w_in, dis
     if loads:
         note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, a_lo, a_hi, grav, summary)
     return k, tau, -1, time_in_mode, peak_xb, peak_xs

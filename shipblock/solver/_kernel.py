@@ -127,6 +127,7 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     S_UPLIFT,
     S_W_IN,
     SAFETY,
+    W_FOLDED,
     Y_DIS,
     Y_IMP,
     Y_OM,
@@ -384,18 +385,18 @@ def interface_option(v, i):
 
 
 @njit(cache=True, forceinline=True)
-def interface_violation(held, excess, new, push):
-    """How much a candidate violates one interface's conditions (0 when it satisfies them).
+def interface_violated(held, excess, excess_tol, new, push, push_tol):
+    """Whether a candidate violates one interface's conditions.
 
     A held interface (stick, rest) violates its friction cone or moment criterion by
-    ``excess`` (dimensionless, > ``FORCE_TOL``); a motion that would start must accelerate
-    in its direction, ``push`` (in g) > ``ACC_TOL``.
+    ``excess`` > ``excess_tol`` (``FORCE_TOL`` times the weight the criterion is relative
+    to); a motion that would start must accelerate in its direction, ``push`` >
+    ``push_tol`` (``ACC_TOL`` times g, with the acceleration at the interface). The
+    tolerances are scaled instead of the quantities divided: this runs for every candidate.
     """
     if held:
-        return excess if excess > FORCE_TOL else 0.0
-    if new and push <= ACC_TOL:
-        return ACC_TOL - push
-    return 0.0
+        return excess > excess_tol
+    return new and push <= push_tol
 
 
 @njit(cache=True, forceinline=False)
@@ -511,8 +512,9 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
     G = p[P_G] + b
     if G <= 0.0:
         return 2  # the ground falls at least as fast as gravity: nothing presses the bodies together
-    weight = (p[P_NM] + p[P_M]) * p[P_G]
-    ship_weight = p[P_M] * p[P_G]
+    force_tol = FORCE_TOL * (p[P_NM] + p[P_M]) * p[P_G]  # relative to the weight
+    ship_force_tol = FORCE_TOL * p[P_M] * p[P_G]  # to the ship's
+    acc_tol = ACC_TOL * p[P_G]
     vb, th, om, vs = y[Y_VB], y[Y_TH], y[Y_OM], y[Y_VS]
     rot = th if th != 0.0 else om
     all_separate = True
@@ -542,21 +544,18 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
                                    sn, om, a, G, w7):
                 continue
         fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
-        viol = 0.0
-        separate = fy <= 0.0 or Fy <= 0.0
-        if not separate:
-            all_separate = False
-        else:
-            viol += max(0.0, -fy / weight) + max(0.0, -Fy / ship_weight) + 1.0
+        if fy <= 0.0 or Fy <= 0.0:
+            continue  # a normal force pulls: this contact would separate
+        all_separate = False
         # ground, rocking, ship: the constraint held, or the new motion's push
-        viol += interface_violation(
-            slip1 == 0, (abs(fx) - p[P_MUS1] * fy) / weight, new1, sig1 * w7[0] / p[P_G])
-        viol += interface_violation(
-            rock == 0, (p[P_H] * abs(fx + Fx) - p[P_B] * (fy + Fy)) / (weight * p[P_R]),
-            newr, s * w7[1] * p[P_R] / p[P_G])
-        viol += interface_violation(
-            slip2 == 0, (abs(Fx) - p[P_MUS2] * Fy) / ship_weight, new2, sig2 * w7[2] / p[P_G])
-        if viol == 0.0:
+        if interface_violated(slip1 == 0, abs(fx) - p[P_MUS1] * fy, force_tol, new1,
+                              sig1 * w7[0], acc_tol):
+            continue
+        if interface_violated(rock == 0, p[P_H] * abs(fx + Fx) - p[P_B] * (fy + Fy),
+                              force_tol * p[P_R], newr, s * w7[1] * p[P_R], acc_tol):
+            continue
+        if not interface_violated(slip2 == 0, abs(Fx) - p[P_MUS2] * Fy, ship_force_tol, new2,
+                                  sig2 * w7[2], acc_tol):
             # the most preferred consistent candidate: the choice
             ms[0], ms[1], ms[2], ms[3], ms[4], ms[5] = slip1, rock, slip2, s, sig1, sig2
             return 0
@@ -898,8 +897,9 @@ summary, y_init
                 hist, modes, span_work, summary)
             if best_e != -2:
                 summary[S_MODE_TIME + mode_number(ms) - 1] += span_time
-                span_loads(p_vec, ms, span_work, ax, ay, has_ay, sh, sv, dt, k_before,
-                           tau_before, k, tau, summary)
+                if span_work[W_FOLDED] == 0.0:  # the span left its loads to be scanned
+                    span_loads(p_vec, ms, span_work, ax, ay, has_ay, sh, sv, dt, k_before,
+                               tau_before, k, tau, summary)
                 loads_pending = False
             if k != k_before:
                 events_here = 0

@@ -84,12 +84,13 @@ W_INV_WR = W_INV_W + 2  # 1 / (weight R)
 # per response slot, the horizontal accelerations [lo, hi] at which the conditions the mode
 # holds surely hold without a vertical input (see ``held_interval``), set with its response
 W_HELD = W_INV_W + 3
-# per response slot, its quiet interval of the contact loads (``quiet_interval`` in
-# shipblock.solver._load_peaks: lo, hi), the four running peaks it was computed from and 1 once
-# computed (0 at the start of a run)
-W_QUIET = W_HELD + 2 * N_RESP_SLOTS
-N_QUIET = 7
-N_SPAN_WORK = W_QUIET + N_QUIET * N_RESP_SLOTS
+# per response slot, the range [lo, hi] of scaled horizontal input whose contact loads have been
+# noted in the run's peaks (see ``note_span_extremes`` in shipblock.solver._load_peaks), set
+# empty (inf, -inf) with its response vectors
+W_NOTED = W_HELD + 2 * N_RESP_SLOTS
+# 1 if the last span noted its contact loads itself, 0 if span_loads is to scan them
+W_FOLDED = W_NOTED + 2 * N_RESP_SLOTS
+N_SPAN_WORK = W_FOLDED + 1
 
 # Numerical constants (documented in docs/theory/solver.md).
 ROOT_TIME_TOL = 1e-12  # [s] width of the bracket that locates an event

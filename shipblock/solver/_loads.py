@@ -120,11 +120,10 @@ def span_loads(p, ms, work, ax, ay, has_ay, sh, sv, dt, k0, tau0, k1, tau1, summ
     (``fy = fy_G G``, ``Fy = Fy_G G``), so over the samples: the peak normal forces are those
     of the greatest ``G``; the peak ``|fx|`` that of the greatest or least ``fx``; the peak
     utilisation ``|fx_a (a/G) + fx_G| / (mu fy_G)`` that of the greatest or least ``a/G``.
-    Without a vertical input ``G = g`` and the samples' loads are noted by the span itself
-    (:func:`~shipblock.solver._load_peaks.folds_loads`): its scan for the next event passes
-    the samples inside :func:`~shipblock.solver._load_peaks.quiet_interval` by two comparisons
-    and notes the others, so only the span's ends are noted here. (A mode whose normal forces
-    did depend on ``a`` would be scanned sample by sample.)
+    Without a vertical input ``G = g`` and the span notes its loads itself, ends included,
+    from the least and greatest ``a`` it passed
+    (:func:`~shipblock.solver._load_peaks.note_span_extremes`), and nothing is done here. (A
+    mode whose normal forces did depend on ``a`` would be scanned sample by sample.)
     """
     start = mode_response_start(p, work, ms[MS_SLIP1], float(ms[MS_SIG1]), ms[MS_SLIP2],
                                 float(ms[MS_SIG2]))
