@@ -23,7 +23,7 @@ from shipblock.solver._inputs import (
     check_initial_state,
     check_options,
 )
-from shipblock.solver._threads import batch_threads, run_on_threads
+from shipblock.solver._threads import MIN_PARALLEL_SAMPLES, batch_threads, run_on_threads
 from shipblock.system import P_THC, ShipBlockSystem
 
 #: Default relative tolerance of the rocking integration [-].
@@ -70,7 +70,20 @@ PER_BLOCK_FIELDS = ("peak_ground_normal_force", "peak_ground_friction_force",
 #: The rows of the kernel's summaries that simulate_batch returns, by name.
 _OUTPUT_ROWS = (*SUMMARY_FIELDS.items(),
                 *((name, K.S_MODE_TIME + m) for m, name in enumerate(MODE_TIME_FIELDS)))
-_PER_BLOCK_ROWS = np.array([SUMMARY_FIELDS[name] for name in PER_BLOCK_FIELDS])
+
+
+def _row_runs(rows) -> tuple[slice, ...]:
+    """Sorted row indices as slices of consecutive rows (one in-place operation each)."""
+    runs = []
+    for i in sorted(rows):
+        if runs and runs[-1][1] == i:
+            runs[-1][1] = i + 1
+        else:
+            runs.append([i, i + 1])
+    return tuple(slice(a, b) for a, b in runs)
+
+
+_PER_BLOCK_ROWS = _row_runs(SUMMARY_FIELDS[name] for name in PER_BLOCK_FIELDS)
 
 
 def _is_motion(value) -> bool:
@@ -405,20 +418,20 @@ def simulate_batch(
     args = (params, packed.acc_h, packed.acc_v, packed.offsets, packed.dts, packed.has_v, rec_idx,
             par_idx, scale_h, scale_v, rtol, atol, zeno_omega, np.zeros(1, dtype=np.int64), summaries,
             False, *K.no_histories(), np.zeros(6))
-    requested = numba.get_num_threads()
     n_threads = 1
-    if requested > 1 and rec_idx.size > 1:
-        n_samples = float(np.diff(packed.offsets)[rec_idx].sum())
-        n_threads = batch_threads(requested, rec_idx.size, n_samples)
+    if rec_idx.size > 1:
+        n_samples = float(packed.lengths[rec_idx].sum())
+        if n_samples >= MIN_PARALLEL_SAMPLES:  # (below it, one thread whatever numba allows)
+            n_threads = batch_threads(numba.get_num_threads(), rec_idx.size, n_samples)
     run_on_threads(K.run_cases, args, n_threads)
     # one field per row, each row contiguous: the arrays returned are views of one block
     # (rows taken by iteration and the per-block totals divided in place: for a short batch
     # these steps would otherwise cost as much as some of its runs)
     by_field = np.ascontiguousarray(summaries.T)
-    if len(systems) == 1:
-        by_field[_PER_BLOCK_ROWS] /= float(systems[0].n_blocks)
-    else:
-        by_field[_PER_BLOCK_ROWS] /= np.array([s.n_blocks for s in systems], dtype=float)[par_idx]
+    n_blocks = (float(systems[0].n_blocks) if len(systems) == 1
+                else np.array([s.n_blocks for s in systems], dtype=float)[par_idx])
+    for rows in _PER_BLOCK_ROWS:
+        by_field[rows] /= n_blocks
     rows = list(by_field)
     out = {name: rows[i] for name, i in _OUTPUT_ROWS}
     out["peak_rotation_ratio"] = out["peak_rotation"] / params[par_idx, P_THC]

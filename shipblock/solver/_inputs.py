@@ -200,6 +200,7 @@ class RecordSet:
                 i = int(np.flatnonzero(bad)[0])
                 check_finite_samples(arrays[i], f"records[{i}] {label}")
         self.acc_h, self.acc_v, self.offsets = acc_h, acc_v, offsets
+        self.lengths = np.diff(offsets)  # samples per record
         self.dts = dts_arr
         self.has_v = has_v
         self.peak_h, self.peak_v = peak_h, peak_v

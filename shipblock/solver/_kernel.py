@@ -128,6 +128,8 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     S_W_IN,
     SAFETY,
     W_FOLDED,
+    W_NOTED,
+    W_RESP_STATE,
     Y_DIS,
     Y_IMP,
     Y_OM,
@@ -1261,22 +1263,30 @@ def run_cases(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_param
     span_work = np.zeros(N_SPAN_WORK)
     armed = np.ones(N_EVENTS, dtype=np.bool_)
     ms = np.zeros(6, dtype=np.int64)
-    first = True
+    # the rows of the work arrays, taken once (each view taken per case costs a reference
+    # count update on entry and exit)
+    y, y1, yr, ytmp, f_end = vectors[0], vectors[1], vectors[2], vectors[3], vectors[4]
+    w7a, w7b = w7[0], w7[1]
+    g0, g1, gw = g[0], g[1], g[2]
+    last_params = -1
     while True:
         c = claim_next(next_case)
         if c >= n_cases:
             break
-        if not first:
-            # every case starts from the work arrays as allocated: zeros, all events armed
-            _reset_work(vectors, stages, w7, K, g, span_work, armed, ms)
-        first = False
+        if last_params >= 0:
+            # every case starts from the work arrays as allocated (zeros, all events armed),
+            # but for the non-rocking modes' response vectors, kept from the case before when
+            # it had the same parameters (they depend on nothing else)
+            _reset_work(vectors, stages, w7, K, g, span_work, armed, ms,
+                        case_params[c] == last_params)
+        last_params = case_params[c]
         r = case_record[c]
         a0 = offsets[r]
         a1 = offsets[r + 1]
         integrate(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
                   case_sv[c], dts[r], rtol, atol, zeno_omega, store, hist, modes, ev_t, ev_kft,
-                  summaries[c], y_init, vectors[0], vectors[1], vectors[2], vectors[3],
-                  vectors[4], stages, w7[0], w7[1], K, g[0], g[1], g[2], span_work, armed, ms)
+                  summaries[c], y_init, y, y1, yr, ytmp, f_end, stages, w7a, w7b, K, g0, g1, gw,
+                  span_work, armed, ms)
 
 
 def no_histories():
@@ -1286,14 +1296,26 @@ def no_histories():
 
 
 @njit(cache=True, forceinline=True, _nrt=False)
-def _reset_work(vectors, stages, w7, K, g, span_work, armed, ms):
-    """The work arrays of :func:`run_cases` back to their state as allocated."""
+def _reset_work(vectors, stages, w7, K, g, span_work, armed, ms, keep_responses):
+    """The work arrays of :func:`run_cases` back to their state as allocated; with
+    ``keep_responses`` (the next case has the same parameters) all but the closed-form spans'
+    solutions that depend on the parameters alone: the non-rocking modes' response vectors,
+    held intervals and inverse weights (``W_RESP_STATE`` up to ``W_NOTED``). The range of
+    input noted per mode belongs to a run: it is emptied."""
     for a in (vectors, stages, w7, K, g):
         for i in range(a.shape[0]):
             for j in range(a.shape[1]):
                 a[i, j] = 0.0
-    for i in range(span_work.shape[0]):
-        span_work[i] = 0.0
+    if keep_responses:
+        for i in range(W_RESP_STATE):
+            span_work[i] = 0.0
+        for i in range(W_NOTED, W_FOLDED, 2):
+            span_work[i] = np.inf
+            span_work[i + 1] = -np.inf
+        span_work[W_FOLDED] = 0.0
+    else:
+        for i in range(span_work.shape[0]):
+            span_work[i] = 0.0
     for i in range(armed.shape[0]):
         armed[i] = True
     for i in range(ms.shape[0]):
