@@ -294,6 +294,19 @@ def _case_columns(cases, packed: RecordSet, n_systems: int):
         raise ParameterError("cases must have shape (n_cases, 4): record, system, scale_h, "
                              f"scale_v; got shape {table.shape}")
     columns = table.T.copy()  # one contiguous row per column
+    limit = checks.MAX_ACCELERATION * (1.0 + 1e-12)  # a record scaled to exactly 100 g runs
+    if columns.shape[1]:
+        # the usual table at a few operations: every column within its bounds (a NaN makes its
+        # column's extremes NaN, which fail every comparison), then the indices whole
+        (lo_r, lo_s, lo_h, lo_v), (hi_r, hi_s, hi_h, hi_v) = (columns.min(axis=1).tolist(),
+                                                              columns.max(axis=1).tolist())
+        if (lo_r >= 0.0 and hi_r < n_records and lo_s >= 0.0 and hi_s < n_systems
+                and max(-lo_h, hi_h) * packed.top_h <= limit
+                and max(-lo_v, hi_v) * packed.top_v <= limit):
+            idx = columns[:2].astype(np.int64)
+            if (idx == columns[:2]).all():
+                return idx[0], idx[1], columns[2], columns[3]
+    # otherwise each check in turn, the first failure named
     if not np.isfinite(columns).all():
         col, row = np.argwhere(~np.isfinite(columns))[0]
         raise ParameterError(f"cases[{row}, {col}] ({CASE_COLUMNS[col]}) is {columns[col, row]}: "
@@ -313,10 +326,6 @@ def _case_columns(cases, packed: RecordSet, n_systems: int):
                     raise ParameterError(
                         f"cases[{row}, {col}] ({what} index) is {idx[col, row]}: out of range, "
                         f"with {n} {what}{'s' if n != 1 else ''}")
-        limit = checks.MAX_ACCELERATION * (1.0 + 1e-12)  # a record scaled to exactly 100 g runs
-        top_h, top_v = np.abs(columns[2:]).max(axis=1).tolist()
-        if top_h * packed.top_h <= limit and top_v * packed.top_v <= limit:
-            return idx[0], idx[1], columns[2], columns[3]  # no record can be scaled above it
         for col, peaks, what in ((2, packed.peak_h, "horizontal"), (3, packed.peak_v, "vertical")):
             scaled = np.abs(columns[col]) * peaks[idx[0]]
             if not (scaled <= limit).all():
