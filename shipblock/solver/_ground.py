@@ -5,7 +5,7 @@ from __future__ import annotations
 from numba import njit
 
 
-@njit(cache=True, forceinline=False)
+@njit(cache=True, forceinline=False, _nrt=False)
 def ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt):
     """Scaled ground acceleration (a, ay) at t_k + tau, linear between samples [m/s^2]."""
     n = ax.shape[0]

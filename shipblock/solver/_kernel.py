@@ -1251,7 +1251,6 @@ def run_cases(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_param
     y_init : ndarray, shape (6,)
         Initial state of every case.
     """
-    n_cases = case_record.shape[0]
     # the work arrays of integrate, allocated once per call and reset for every case
     vectors = np.zeros((5, N_STATE))
     stages = np.zeros((7, N_STATE))
@@ -1263,8 +1262,23 @@ def run_cases(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_param
     span_work = np.zeros(N_SPAN_WORK)
     armed = np.ones(N_EVENTS, dtype=np.bool_)
     ms = np.zeros(6, dtype=np.int64)
-    # the rows of the work arrays, taken once (each view taken per case costs a reference
-    # count update on entry and exit)
+    _run_claimed(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
+                 case_sv, rtol, atol, zeno_omega, next_case, summaries, store, hist, modes, ev_t,
+                 ev_kft, y_init, vectors, stages, w7, K, g, span_work, armed, ms)
+
+
+@njit(cache=True, forceinline=False, nogil=True, _nrt=False)
+def _run_claimed(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
+                 case_sv, rtol, atol, zeno_omega, next_case, summaries, store, hist, modes, ev_t,
+                 ev_kft, y_init, vectors, stages, w7, K, g, span_work, armed, ms):
+    """The loop of :func:`run_cases` over the cases it claims, in the work arrays it allocated.
+
+    Compiled without reference counting: with it, every array passed to :func:`integrate`
+    had its count raised and lowered around each call (some fifty atomic operations a case,
+    half the start of a short case).
+    """
+    n_cases = case_record.shape[0]
+    # the rows of the work arrays, taken once
     y, y1, yr, ytmp, f_end = vectors[0], vectors[1], vectors[2], vectors[3], vectors[4]
     w7a, w7b = w7[0], w7[1]
     g0, g1, gw = g[0], g[1], g[2]
@@ -1302,10 +1316,13 @@ def _reset_work(vectors, stages, w7, K, g, span_work, armed, ms, keep_responses)
     solutions that depend on the parameters alone: the non-rocking modes' response vectors,
     held intervals and inverse weights (``W_RESP_STATE`` up to ``W_NOTED``). The range of
     input noted per mode belongs to a run: it is emptied."""
-    for a in (vectors, stages, w7, K, g):
-        for i in range(a.shape[0]):
-            for j in range(a.shape[1]):
-                a[i, j] = 0.0
+    # each array in turn, not a tuple of them: building a tuple of arrays updates their
+    # reference counts (atomically), which cost as much as the rest of a short case's start
+    vectors[:, :] = 0.0
+    stages[:, :] = 0.0
+    w7[:, :] = 0.0
+    K[:, :] = 0.0
+    g[:, :] = 0.0
     if keep_responses:
         for i in range(W_RESP_STATE):
             span_work[i] = 0.0
