@@ -127,3 +127,29 @@ def test_read_only_records_use_the_same_compiled_solver():
     np.testing.assert_array_equal(read_only.x_b, writable.x_b)
     assert writable.summary["peak_block_slip"] > 0.0  # the record does move the blocks
     assert horizontal_only.summary["peak_block_slip"] > 0.0
+
+
+_ONE_KERNEL = """
+import json
+import numpy as np
+from shipblock import RecordSet, ShipBlockSystem, simulate, simulate_batch
+from shipblock.solver import _kernel as K
+
+system = ShipBlockSystem.example()
+ax = 3.0 * np.sin(np.linspace(0.0, 20.0, 400))
+simulate(system, ax, 0.3 * ax, 0.01)
+simulate(system, ax, None, 0.01)
+simulate_batch(system, [(ax, None), (ax, 0.5 * ax)], 0.01, [(0, 0, 1.0, 1.0), (1, 0, 2.0, 1.0)])
+simulate_batch([system, system.replace(n_blocks=10)], RecordSet([(ax, None)], [0.01]),
+               cases=[(0, 1, 1.0, 1.0)])
+print(json.dumps({"run_cases": len(K.run_cases.signatures)}))
+"""
+
+
+def test_every_entry_point_shares_one_compiled_kernel():
+    """simulate (histories, with and without a vertical input) and simulate_batch (one system
+    or several, records listed or packed) all call the kernel with the same argument types:
+    the solver is compiled once, not once more for, say, a read-only parameter array."""
+    out = subprocess.run([sys.executable, "-c", _ONE_KERNEL], capture_output=True, text=True,
+                         cwd=ROOT, timeout=600, check=True)
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == {"run_cases": 1}

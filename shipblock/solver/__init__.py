@@ -406,7 +406,8 @@ def simulate_batch(
         if not isinstance(s, ShipBlockSystem):
             raise ParameterTypeError(f"systems[{i}] must be a ShipBlockSystem, got "
                                      f"{type(s).__name__}")
-    params = (systems[0].kernel_parameters[None, :] if len(systems) == 1
+    # (a writable copy: the kernel compiled for read-only arrays would be a second compile)
+    params = (systems[0].kernel_parameters[None, :].copy() if len(systems) == 1
               else np.array([s.kernel_parameters for s in systems]))
     rtol, atol, zeno_omega = check_options(rtol, atol, zeno_omega)
     if isinstance(records, RecordSet):
