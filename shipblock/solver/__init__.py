@@ -86,6 +86,12 @@ def _row_runs(rows) -> tuple[slice, ...]:
 _PER_BLOCK_ROWS = _row_runs(SUMMARY_FIELDS[name] for name in PER_BLOCK_FIELDS)
 
 
+def _run_cases_in_new_work(*args) -> None:
+    """:func:`~shipblock.solver._kernel.run_cases` in work arrays of its own (one set per
+    thread)."""
+    K.run_cases(*args, *K.new_work())
+
+
 def _is_motion(value) -> bool:
     """Whether ``value`` is a :class:`shipblock.motion.GroundMotion` (without importing obspy)."""
     return all(hasattr(value, a) for a in ("horizontal", "vertical", "dt"))
@@ -433,7 +439,7 @@ def simulate_batch(
         n_samples = float(packed.lengths[rec_idx].sum())
         if n_samples >= MIN_PARALLEL_SAMPLES:  # (below it, one thread whatever numba allows)
             n_threads = batch_threads(numba.get_num_threads(), rec_idx.size, n_samples)
-    run_on_threads(K.run_cases, args, n_threads)
+    run_on_threads(_run_cases_in_new_work, args, n_threads)
     # one field per row, each row contiguous: the arrays returned are views of one block
     # (rows taken by iteration and the per-block totals divided in place: for a short batch
     # these steps would otherwise cost as much as some of its runs)

@@ -778,7 +778,8 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
               np.array([0, ax.shape[0]], dtype=np.int64), np.array([float(dt)]),
               np.array([has_ay], dtype=np.bool_), ints[0], ints[1], np.array([float(sh)]),
               np.array([float(sv)]), rtol, atol, zeno_omega, ints[2], summary.reshape(1, -1),
-              bool(store), hist, modes, ev_t, ev_kft, np.asarray(y_init, dtype=float))
+              bool(store), hist, modes, ev_t, ev_kft, np.asarray(y_init, dtype=float),
+              *new_work())
 
 
 # IEEE division (error_model="numpy") as in the closed-form span inlined here: the default
@@ -1209,10 +1210,15 @@ summary, y_init
     ) + potential_energy(p, y[Y_TH])
 
 
-@njit(cache=True, forceinline=False, nogil=True)
+# without reference counting: with it, every array passed to integrate had its count raised and
+# lowered around each case (some fifty atomic operations, half the start of a short case); and
+# the work arrays are allocated by the caller (new_work), not here: a compiled function that
+# allocated them and called this one would have the solver's code optimised once more (2 s of
+# the cold start)
+@njit(cache=True, forceinline=False, nogil=True, _nrt=False)
 def run_cases(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
               case_sv, rtol, atol, zeno_omega, next_case, summaries, store, hist, modes, ev_t,
-              ev_kft, y_init):
+              ev_kft, y_init, vectors, stages, w7, K, g, span_work, armed, ms):
     """Run cases until none is left; each case is (record, parameter row, H scale, V scale).
 
     The one compiled entry point of the solver: :func:`run` (one record, with its histories)
@@ -1250,35 +1256,13 @@ def run_cases(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_param
         empty arrays otherwise).
     y_init : ndarray, shape (6,)
         Initial state of every case.
-    """
-    # the work arrays of integrate, allocated once per call and reset for every case
-    vectors = np.zeros((5, N_STATE))
-    stages = np.zeros((7, N_STATE))
-    w7 = np.zeros((2, N_SOLVE_OUT))
-    K = np.zeros((3, 3))
-    g = np.zeros((3, N_EVENTS))
-    # the closed-form spans' work array: response vectors of the non-rocking modes, solved
-    # once per run, and the like (see nonrocking_span)
-    span_work = np.zeros(N_SPAN_WORK)
-    armed = np.ones(N_EVENTS, dtype=np.bool_)
-    ms = np.zeros(6, dtype=np.int64)
-    _run_claimed(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
-                 case_sv, rtol, atol, zeno_omega, next_case, summaries, store, hist, modes, ev_t,
-                 ev_kft, y_init, vectors, stages, w7, K, g, span_work, armed, ms)
-
-
-@njit(cache=True, forceinline=False, nogil=True, _nrt=False)
-def _run_claimed(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
-                 case_sv, rtol, atol, zeno_omega, next_case, summaries, store, hist, modes, ev_t,
-                 ev_kft, y_init, vectors, stages, w7, K, g, span_work, armed, ms):
-    """The loop of :func:`run_cases` over the cases it claims, in the work arrays it allocated.
-
-    Compiled without reference counting: with it, every array passed to :func:`integrate`
-    had its count raised and lowered around each call (some fifty atomic operations a case,
-    half the start of a short case).
+    vectors, stages, w7, K, g, span_work, armed, ms : ndarray
+        Work arrays of :func:`integrate`, as :func:`new_work` allocates them, one set per
+        calling thread.
     """
     n_cases = case_record.shape[0]
-    # the rows of the work arrays, taken once
+    # the rows of the work arrays, taken once (a view taken per case costs as much as a
+    # reference count update would)
     y, y1, yr, ytmp, f_end = vectors[0], vectors[1], vectors[2], vectors[3], vectors[4]
     w7a, w7b = w7[0], w7[1]
     g0, g1, gw = g[0], g[1], g[2]
@@ -1301,6 +1285,13 @@ def _run_claimed(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_pa
                   case_sv[c], dts[r], rtol, atol, zeno_omega, store, hist, modes, ev_t, ev_kft,
                   summaries[c], y_init, y, y1, yr, ytmp, f_end, stages, w7a, w7b, K, g0, g1, gw,
                   span_work, armed, ms)
+
+
+def new_work() -> tuple:
+    """A set of work arrays for one thread's :func:`run_cases`: zeros, all events armed."""
+    return (np.zeros((5, N_STATE)), np.zeros((7, N_STATE)), np.zeros((2, N_SOLVE_OUT)),
+            np.zeros((3, 3)), np.zeros((3, N_EVENTS)), np.zeros(N_SPAN_WORK),
+            np.ones(N_EVENTS, dtype=np.bool_), np.zeros(6, dtype=np.int64))
 
 
 def no_histories():
