@@ -207,7 +207,8 @@ def exact_step(xb, vb0, xs, vs0, w_in, dis, h, ub0, ub1, us0, us1, a0, a1, fx0, 
 
     Velocities are quadratic and slips cubic in time; the input power -a P_x and the friction
     dissipation rate -(fx v_b + Fx v_s) are cubic, so Simpson's rule integrates them exactly.
-    Values in and out (rather than the state array) let the span's loop keep them in registers.
+    Values in and out (rather than the state array), so that the span's loop keeps them in
+    locals and writes the state only where it is read.
     """
     vb1 = vb0 + 0.5 * h * (ub0 + ub1)
     vs1 = vs0 + 0.5 * h * (us0 + us1)
@@ -748,8 +749,8 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
                              a0, a_end, fx0, fx0 + (fx1 - fx0) * u, Fx0,
                              Fx0 + (Fx1 - Fx0) * u, mass_b, M)
                 if loads:
-                    note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, min(a_lo, a_end),
-                                       max(a_hi, a_end), grav, summary)
+                    note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g,
+                                       min(a_lo, a_end), max(a_hi, a_end), grav, summary)
                 return k, tau + best_h, best_e, time_in_mode + best_h, peak_xb, peak_xs
         # no event: advance exactly to the next sample
         moving_b = slip1 or vb0 != 0.0
@@ -789,7 +790,8 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
                 store_sample(p, ms, y, hist, modes, k, mode)
     y[Y_XB], y[Y_VB], y[Y_XS], y[Y_VS], y[Y_WIN], y[Y_DIS] = xb, vb, xs, vs, w_in, dis
     if loads:
-        note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, a_lo, a_hi, grav, summary)
+        note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, a_lo, a_hi, grav,
+                           summary)
     return k, tau, -1, time_in_mode, peak_xb, peak_xs
 
 

@@ -68,7 +68,8 @@ def note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, a, G, sum
 
 
 @njit(cache=True, forceinline=True)
-def note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, a_lo, a_hi, G, summary):
+def note_span_extremes(p, work, slot, fx_a, fx_g, fy_g, Fx_a, Fx_g, Fy_g, a_lo, a_hi, G,
+                       summary):
     """Note the loads of a non-rocking span whose scaled horizontal input [m/s^2] ranged over
     ``[a_lo, a_hi]`` at its samples and ends, in a mode whose normal forces do not depend on
     it (:func:`folds_loads`, ``G = g``): the peaks of noting every one of those inputs, to the
