@@ -2,23 +2,18 @@
 
 The physics (all eight modes of motion, transitions, impacts and failure) is in
 :mod:`shipblock.equations`, :mod:`shipblock.impact` and :mod:`shipblock.solver`; ground motions
-in :mod:`shipblock.motion`, :mod:`shipblock.processing`, :mod:`shipblock.scaling` and
+in :mod:`shipblock.records`, :mod:`shipblock.processing`, :mod:`shipblock.scaling` and
 :mod:`shipblock.intensity`; batch runs and fragility in :mod:`shipblock.fragility`.
 """
 
 from __future__ import annotations
 
 import importlib
-from importlib.metadata import PackageNotFoundError, version
-
-try:
-    __version__ = version("shipblock")
-except PackageNotFoundError:  # running from a source tree that is not installed
-    __version__ = "0+unknown"
 
 from shipblock.modes import EventKind, Failure, Mode
 from shipblock.result import Energy, Event, SimulationResult
 from shipblock.system import ShipBlockSystem, system_restitution
+from shipblock.version import __version__
 
 # Heavier parts load on first use (numba and the solver, obspy, xarray, scipy.stats): a command
 # that does not simulate does not import the solver.
@@ -26,14 +21,14 @@ _LAZY = {
     "simulate": "shipblock.solver",
     "simulate_batch": "shipblock.solver",
     "RecordSet": "shipblock.solver",
-    "read_motion": "shipblock.motion",
-    "GroundMotion": "shipblock.motion",
-    "COMPONENT_KEY": "shipblock.motion",
-    "rotate_to_azimuth": "shipblock.motion",
+    "read_motion": "shipblock.records.reading",
+    "GroundMotion": "shipblock.records.motion",
+    "COMPONENT_KEY": "shipblock.records.motion",
+    "rotate_to_azimuth": "shipblock.records.motion",
     "read_record": "shipblock.io",
-    "read_motions": "shipblock.collection",
-    "MotionSet": "shipblock.collection",
-    "load_catalogue": "shipblock.catalogue",
+    "read_motions": "shipblock.records.folders",
+    "MotionSet": "shipblock.records.folders",
+    "load_catalogue": "shipblock.records.catalogue",
     "ShipblockError": "shipblock.errors",
     "RecordError": "shipblock.errors",
     "UnitsError": "shipblock.errors",

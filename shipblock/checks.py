@@ -28,7 +28,13 @@ from collections.abc import Collection
 import numpy as np
 
 from shipblock.errors import ParameterError, ParameterTypeError, RecordError
-from shipblock.units import ACCELERATION_UNITS_TO_SI, STANDARD_GRAVITY, VELOCITY_UNITS_TO_SI
+from shipblock.units import (
+    ACCELERATION_UNITS_TO_SI,
+    STANDARD_GRAVITY,
+    VELOCITY_UNITS_TO_SI,
+    canonical_unit,
+    canonical_velocity_unit,
+)
 
 __all__ = [
     "MAX_ACCELERATION",
@@ -44,7 +50,6 @@ __all__ = [
     "choice",
     "existing_file",
     "flag",
-    "ground_motion",
     "is_real",
     "pathname",
     "real",
@@ -407,8 +412,6 @@ def unit(value, name: str, *, velocity: bool = True) -> str:
     ParameterError
         If it is not a known unit; the message lists the known ones.
     """
-    from shipblock.io._common import canonical_unit, canonical_velocity_unit
-
     known = "an acceleration unit (" + ", ".join(_unit_words(ACCELERATION_UNITS_TO_SI)) + ")"
     if velocity:
         known += (" or a velocity unit (" + ", ".join(_unit_words(VELOCITY_UNITS_TO_SI))
@@ -418,15 +421,4 @@ def unit(value, name: str, *, velocity: bool = True) -> str:
                                  f"{value!r}")
     if canonical_unit(value) is None and not (velocity and canonical_velocity_unit(value)):
         raise ParameterError(f"{name} must be {known}, got {value!r}")
-    return value
-
-
-def ground_motion(value, name: str = "motion"):
-    """A :class:`shipblock.motion.GroundMotion`, or a ParameterTypeError naming ``name``."""
-    from shipblock.motion import GroundMotion  # lazy: motion imports obspy
-
-    if not isinstance(value, GroundMotion):
-        raise ParameterTypeError(
-            f"{name} must be a shipblock.motion.GroundMotion (from read_motion or "
-            f"GroundMotion.from_arrays), got {type(value).__name__}")
     return value

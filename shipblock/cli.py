@@ -7,8 +7,10 @@ library. User errors print one line ``shipblock: error: ...`` and exit with stat
 from __future__ import annotations
 
 import argparse
+import json
 import logging
 import sys
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -37,14 +39,14 @@ class UserError(Exception):
 
 #: What numba compiles on first use, by the module of the function compiled: (module prefix,
 #: what it is, seconds it took from an empty cache). The seconds are measured by
-#: ``shipblock bench`` (:func:`shipblock.bench_startup.cold_start`, docs/benchmarks.rst) on
+#: ``shipblock bench`` (:func:`shipblock.bench.startup.cold_start`, docs/benchmarks.rst) on
 #: the project's 2-core machine; the notice quotes them, and the log says afterwards how long it
 #: took here.
 COMPILED_PARTS = (
     ("shipblock.solver", "the solver", 22.0),
     ("shipblock.equations", "the solver", 22.0),
     ("shipblock.impact", "the solver", 22.0),
-    ("shipblock.loads", "the contact loads", 0.5),
+    ("shipblock.interface_forces", "the contact loads", 0.5),
     ("shipblock.intensity", "the intensity measures", 0.3),
 )
 
@@ -148,7 +150,7 @@ def _conversion_kwargs(args) -> dict:
 
 
 def _find_entry(record_id, catalogue):
-    from shipblock.catalogue import load_catalogue
+    from shipblock.records.catalogue import load_catalogue
 
     entries = load_catalogue(catalogue)
     if record_id in entries:
@@ -185,7 +187,7 @@ def _processing_chain(spec):
 
 
 def _load_motion(args):
-    from shipblock.motion import read_motion
+    from shipblock.records.reading import read_motion
     from shipblock.processing import process_motion
 
     if args.record and args.files:
@@ -418,8 +420,8 @@ def cmd_info(args):
 
 
 def cmd_catalogue(args):
-    from shipblock.catalogue import catalogue_toml, load_catalogue
-    from shipblock.collection import read_motions
+    from shipblock.records.catalogue import catalogue_toml, load_catalogue
+    from shipblock.records.folders import read_motions
 
     found = read_motions(args.sources, inventory=args.inventory, units=args.units,
                          **_conversion_kwargs(args))
@@ -553,14 +555,14 @@ def cmd_bench(args):
     if args.read:
         import json
 
-        from shipblock.bench_readers import reader_throughput, write_reader_throughput
+        from shipblock.bench.readers import reader_throughput, write_reader_throughput
 
         result = reader_throughput(args.read, min_seconds=0.3 if args.quick else 1.0)
         write_reader_throughput(result, sys.stdout)
         if args.output:
             Path(args.output).write_text(json.dumps(result, indent=2))
         return 0
-    from shipblock.bench import run_benchmarks
+    from shipblock.bench.run import run_benchmarks
 
     if args.campaign_runs is not None and args.campaign_runs < 0:
         raise UserError(f"--campaign-runs must be >= 0, got {args.campaign_runs}")
@@ -589,6 +591,9 @@ def build_parser():
     )
     p.add_argument("-v", "--verbose", action="count", default=0, help="more log output")
     p.add_argument("-q", "--quiet", action="store_true", help="only warnings and errors")
+    # For the cold-start benchmark (shipblock.bench.startup), which runs the command in a fresh
+    # process: the seconds numba compiled, by part, and the process's CPU time, as JSON.
+    p.add_argument("--compile-report", metavar="FILE", help=argparse.SUPPRESS)
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
 
     s = sub.add_parser("simulate", help="simulate one record on one ship-block system",
@@ -704,13 +709,28 @@ def main(argv=None):
     if args.command is None:
         parser.print_help()
         return 2
+    compiled = {}
+    code = _run(args, compiled)
+    if args.compile_report:
+        Path(args.compile_report).write_text(json.dumps(
+            {"code": code, "compiled": compiled, "cpu": time.process_time()}))
+    return code
+
+
+def _run(args, compiled: dict) -> int:
+    """Run the command of ``args``; its exit status. ``compiled`` collects the seconds numba
+    compiled, by part (:func:`compile_notice`)."""
     from shipblock.errors import ShipblockError
+
+    def done(what, seconds):
+        compiled[what] = compiled.get(what, 0.0) + seconds
+        _log_compiled(what, seconds)
 
     try:
         from tqdm.contrib.logging import logging_redirect_tqdm
 
         # log lines go above a progress bar, not onto its line
-        with logging_redirect_tqdm(), compile_notice(log.info, _log_compiled):
+        with logging_redirect_tqdm(), compile_notice(log.info, done):
             return args.func(args)
     except (UserError, ShipblockError, ValueError, FileNotFoundError, OSError) as exc:
         if args.verbose > 1:

@@ -246,7 +246,7 @@ def plot_record(motion, axes=None, label=None):
     Parameters
     ----------
     motion : GroundMotion or tuple
-        A :class:`shipblock.motion.GroundMotion`, or ``(horizontal, vertical, dt)`` in m/s^2.
+        A :class:`shipblock.records.motion.GroundMotion`, or ``(horizontal, vertical, dt)`` in m/s^2.
     axes : sequence of 3 Axes, optional
     label : str, optional
         Title.

@@ -43,6 +43,7 @@ from obspy import Stream, Trace
 from shipblock import checks
 from shipblock.errors import ParameterError, ParameterTypeError, ShipblockError
 from shipblock.intensity import displacement
+from shipblock.records.motion import check_motion
 
 __all__ = [
     "ANTIALIAS_CORNERS",
@@ -244,24 +245,24 @@ def apply_chain(stream: Stream, chain: Iterable[Mapping]) -> Stream:
 
 
 def process_motion(motion, chain: Iterable[Mapping] | None = None):
-    """Apply a chain to a :class:`shipblock.motion.GroundMotion` and return a new one.
+    """Apply a chain to a :class:`shipblock.records.motion.GroundMotion` and return a new one.
 
     Parameters
     ----------
-    motion : shipblock.motion.GroundMotion
+    motion : shipblock.records.motion.GroundMotion
         Input motion [m/s^2]; unchanged.
     chain : iterable of mapping, optional
         Processing chain (see :func:`apply_chain`); None means :data:`DEFAULT_CHAIN`.
 
     Returns
     -------
-    shipblock.motion.GroundMotion
+    shipblock.records.motion.GroundMotion
         New motion built with ``motion.with_stream``; the chain's provenance strings (joined by
         ``"; "``) are appended to ``metadata["processing"]`` as one note, and each trace keeps
         them in ``stats.processing``.
     """
     chain = DEFAULT_CHAIN if chain is None else chain
-    checks.ground_motion(motion)
+    check_motion(motion)
     processed = apply_chain(motion.stream, chain)
     n_old = len(motion.stream[0].stats.get("processing", [])) if len(motion.stream) else 0
     notes = list(processed[0].stats.get("processing", [])[n_old:]) if len(processed) else []

@@ -166,12 +166,12 @@ class SimulationResult:
 
     @cached_property
     def forces(self):
-        """Interface forces per block at the samples (:class:`shipblock.loads.InterfaceForces`).
+        """Interface forces per block at the samples (:class:`shipblock.interface_forces.InterfaceForces`).
 
         Computed on first use from the stored state and input; their peaks between the samples
-        are in :attr:`summary` (``peak_ground_normal_force`` ..., :mod:`shipblock.loads`).
+        are in :attr:`summary` (``peak_ground_normal_force`` ..., :mod:`shipblock.interface_forces`).
         """
-        from shipblock.loads import interface_forces
+        from shipblock.interface_forces import interface_forces
 
         ax, ay = self.ground_acceleration
         return interface_forces(self.system, self.mode, self.theta, self.theta_dot, self.v_b,
@@ -188,7 +188,7 @@ class SimulationResult:
         """
         import xarray as xr
 
-        from shipblock import __version__
+        from shipblock.version import __version__
 
         def var(values, units, long_name, dims=("time",)):
             return xr.Variable(dims, values, attrs={"units": units, "long_name": long_name})

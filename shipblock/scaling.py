@@ -425,7 +425,7 @@ def scale_record(
 
 
 def scale_motion(motion, **options):
-    """Scale a :class:`shipblock.motion.GroundMotion` with :func:`scale_record`.
+    """Scale a :class:`shipblock.records.motion.GroundMotion` with :func:`scale_record`.
 
     The factors are computed on ``motion.horizontal`` (the solver's horizontal) and
     ``motion.vertical``; the horizontal factor multiplies *both* horizontal traces (H1, H2), so
@@ -434,7 +434,7 @@ def scale_motion(motion, **options):
 
     Parameters
     ----------
-    motion : shipblock.motion.GroundMotion
+    motion : shipblock.records.motion.GroundMotion
         Input motion [m/s^2]; unchanged.
     **options
         Keyword arguments of :func:`scale_record` (``target``, ``factor``, ``measure``,
@@ -442,15 +442,16 @@ def scale_motion(motion, **options):
 
     Returns
     -------
-    motion : shipblock.motion.GroundMotion
+    motion : shipblock.records.motion.GroundMotion
         New scaled motion, with a note in ``metadata["processing"]`` and a provenance string
         ``shipblock.scaling.scale_record(...)`` in every trace's ``stats.processing``.
     scaled : ScaledRecord
         The factors and achieved measures.
     """
-    from shipblock.motion import COMPONENT_KEY  # lazy: motion imports obspy
+    # lazy, for start-up time: the records import obspy
+    from shipblock.records.motion import COMPONENT_KEY, check_motion
 
-    checks.ground_motion(motion)
+    check_motion(motion)
     result = scale_record(motion.horizontal, motion.vertical, motion.dt, **options)
     args = ", ".join(f"{k}={v!r}" for k, v in sorted(options.items()))
     entry = (

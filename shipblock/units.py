@@ -1,15 +1,19 @@
-"""Physical constants and unit conversions.
+"""Physical constants, unit names and conversions.
 
-This module is the only home of physical constants in shipblock. Everything inside the package is
-SI (m, s, kg, rad, m/s^2); conversions from user units happen once, at the edges, through the
-helpers below.
+This module is the only home of physical constants and of unit names in shipblock: the SI
+factors of acceleration and velocity units, the spellings of units that records and users write
+(:data:`UNIT_ALIASES`, :func:`canonical_unit`, :func:`canonical_velocity_unit`) and the
+conversions. Everything inside the package is SI (m, s, kg, rad, m/s^2); conversions from user
+and record units happen once, at the edges (the record readers of :mod:`shipblock.io`, the
+records of :mod:`shipblock.records`, argument checks), through the helpers below. It sits at the
+bottom of the package's layers (docs/architecture.rst) and imports only :mod:`shipblock.errors`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from shipblock.errors import ParameterError
+from shipblock.errors import ParameterError, UnitsError
 
 #: Standard acceleration of gravity [m/s^2] (CGPM 1901, ISO 80000-3).
 STANDARD_GRAVITY = 9.80665
@@ -45,6 +49,43 @@ VELOCITY_UNITS_TO_SI: dict[str, float] = {
     "mm/s": 0.001,
     "nm/s": 1e-9,
     "in/s": INCH,
+}
+
+
+#: Accepted spellings of acceleration units, mapped to the keys of
+#: :data:`ACCELERATION_UNITS_TO_SI`.
+UNIT_ALIASES: dict[str, str] = {
+    "g": "g",
+    "g's": "g",
+    "gs": "g",
+    "g'": "g",
+    "gal": "gal",
+    "gals": "gal",
+    "cm/s^2": "cm/s^2",
+    "cm/s**2": "cm/s^2",
+    "cm/s/s": "cm/s^2",
+    "cm/s2": "cm/s^2",
+    "cm/sec^2": "cm/s^2",
+    "cm/sec2": "cm/s^2",
+    "cm/sec/sec": "cm/s^2",
+    "cm/sec**2": "cm/s^2",
+    "m/s^2": "m/s^2",
+    "m/s**2": "m/s^2",
+    "m/s/s": "m/s^2",
+    "m/s2": "m/s^2",
+    "m/sec^2": "m/s^2",
+    "m/sec2": "m/s^2",
+    "m/sec/sec": "m/s^2",
+    "mm/s^2": "mm/s^2",
+    "mm/s**2": "mm/s^2",
+    "mm/s/s": "mm/s^2",
+    "mm/s2": "mm/s^2",
+    "nm/s^2": "nm/s^2",
+    "nm/s**2": "nm/s^2",
+    "nm/s/s": "nm/s^2",
+    "nm/s2": "nm/s^2",
+    "m/(s**2)": "m/s^2",
+    "m/sec**2": "m/s^2",
 }
 
 
@@ -103,3 +144,55 @@ def velocity_to_si(values, unit: str):
         If the unit is not known.
     """
     return _to_si(values, unit, VELOCITY_UNITS_TO_SI, "velocity")
+
+
+def canonical_unit(unit: str) -> str | None:
+    """Map a spelling of an acceleration unit to a key of the SI conversion table.
+
+    Parameters
+    ----------
+    unit : str
+        For example ``"g"``, ``"G's"``, ``"cm/sec2"``, ``"gal"``, ``"m/s^2"``.
+
+    Returns
+    -------
+    str or None
+        A key of :data:`ACCELERATION_UNITS_TO_SI`, or ``None`` if unknown.
+    """
+    key = unit.strip().lower().replace(" ", "")
+    key = UNIT_ALIASES.get(key, key)
+    return key if key in ACCELERATION_UNITS_TO_SI else None
+
+
+def canonical_velocity_unit(unit: str | None) -> str | None:
+    """Map a spelling of a velocity unit (``"M/S"``, ``"cm/sec"``) to a key of
+    :data:`VELOCITY_UNITS_TO_SI`, or ``None`` if it is not one."""
+    key = (unit or "").strip().lower().replace(" ", "").replace("sec", "s")
+    return key if key in VELOCITY_UNITS_TO_SI else None
+
+
+def si_factor(unit: str, name: str) -> float:
+    """Return the factor that converts ``unit`` to m/s^2.
+
+    Parameters
+    ----------
+    unit : str
+        An acceleration unit (any spelling accepted by :func:`canonical_unit`).
+    name : str
+        File name, for the error message.
+
+    Returns
+    -------
+    float
+        Conversion factor [m/s^2 per unit].
+
+    Raises
+    ------
+    UnitsError
+        If the unit is not a known acceleration unit.
+    """
+    key = canonical_unit(unit)
+    if key is None:
+        known = ", ".join(sorted(set(UNIT_ALIASES.values())))
+        raise UnitsError(name, f"unknown acceleration unit {unit!r}; known units: {known}")
+    return ACCELERATION_UNITS_TO_SI[key]

@@ -18,7 +18,7 @@ from shipblock.fragility import batch as batch_mod
 from shipblock.fragility.batch import prepare_record, run_batch, run_chunk, summary_dataset
 from shipblock.fragility.design import AnalysisDesign, IntensityDesign, apply_parameters
 from shipblock.fragility.store import ChunkStore
-from shipblock.motion import GroundMotion
+from shipblock.records.motion import GroundMotion
 from shipblock.solver import MODE_TIME_FIELDS, SUMMARY_FIELDS
 from shipblock.units import STANDARD_GRAVITY as G
 

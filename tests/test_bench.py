@@ -14,7 +14,7 @@ import sys
 import numpy as np
 import pytest
 
-from shipblock import bench
+from shipblock.bench import campaign, solver, targets, timing
 from shipblock.cli import main
 from shipblock.fragility.pipeline import load_pipeline
 
@@ -23,25 +23,25 @@ from .test_batch import make_catalogue
 
 @pytest.mark.parametrize("n_runs", [1, 6, 50, 324, 1000, 3000, 100_000])
 def test_campaign_grid_is_the_smallest_near_square_grid(n_runs):
-    n_levels, n_mu, n_sl = bench.campaign_grid(n_runs, n_records=6)
+    n_levels, n_mu, n_sl = campaign.campaign_grid(n_runs, n_records=6)
     total = 6 * n_levels * n_mu * n_sl
     assert total >= n_runs
     assert total <= 1.01 * n_runs or total - n_runs < 6 * n_levels * n_mu
     assert n_mu <= n_sl <= max(2 * n_mu, n_mu + 1)
     assert 1 <= n_levels <= 12
-    assert bench.campaign_grid(3000) == (10, 5, 10)  # exactly 3000 runs
-    assert 6 * math.prod(bench.campaign_grid(100_000)) < 100_200
+    assert campaign.campaign_grid(3000) == (10, 5, 10)  # exactly 3000 runs
+    assert 6 * math.prod(campaign.campaign_grid(100_000)) < 100_200
 
 
 def test_campaign_pipeline_is_valid_and_has_the_runs(tmp_path):
-    path, info = bench.write_campaign_pipeline(tmp_path, 1000, chunk_size=128)
+    path, info = campaign.write_campaign_pipeline(tmp_path, 1000, chunk_size=128)
     pipe = load_pipeline(path)
     assert pipe.design.n_cases == info["runs"] >= 1000
     assert len(pipe.design.records) == info["records"] == 6  # the shipped catalogue
     assert pipe.design.shape == (6, info["levels"], info["n_mu"], info["n_slenderness"])
     assert pipe.chunk_size == 128
     assert pipe.fit["bootstrap"] == 0
-    _, info = bench.write_campaign_pipeline(tmp_path / "b", 100_000)
+    _, info = campaign.write_campaign_pipeline(tmp_path / "b", 100_000)
     assert info["chunk_size"] == -(-info["runs"] // 100)  # about 100 chunks
 
 
@@ -51,35 +51,35 @@ def test_kernel_time_is_found_in_a_profile():
 
     from shipblock import simulate_batch
 
-    system = bench.sliding_system()
+    system = timing.sliding_system()
     acc = np.sin(np.arange(4000) * 0.02)
     cases = np.array([[0, 0, 1.0, 1.0]] * 4)
     simulate_batch(system, [(acc, None)], [0.005], cases[:1])
     prof = cProfile.Profile()
     prof.runcall(simulate_batch, system, [(acc, None)], [0.005], cases)
     stats = pstats.Stats(prof)
-    kernel = bench._kernel_seconds(stats)
+    kernel = campaign._kernel_seconds(stats)
     assert 0 < kernel <= stats.total_tt
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc/self/status is Linux")
 def test_memory_is_read_from_proc():
-    rss, peak = bench._memory()
+    rss, peak = campaign._memory()
     assert 1e6 < rss <= peak
     # the peak is a high-water mark: reset it to the current size first (as the campaign does)
-    if not bench._reset_peak():
+    if not campaign._reset_peak():
         pytest.skip("this kernel does not allow resetting the peak resident size")
-    rss, peak = bench._memory()
+    rss, peak = campaign._memory()
     # touch 50 MB of fresh pages (an anonymous map: a numpy array could reuse resident memory
     # the allocator kept from earlier tests, and the resident size would not grow)
     with mmap.mmap(-1, 50_000_000) as block:
         np.frombuffer(block, dtype=np.uint8)[::4096] = 1
-        assert bench._memory()[1] >= peak + 40e6
+        assert campaign._memory()[1] >= peak + 40e6
 
 
 def test_campaign_runs_the_pipeline_in_a_subprocess(tmp_path):
     catalogue = make_catalogue(tmp_path / "records", n_records=2)
-    res = bench.campaign(40, directory=tmp_path / "work", catalogue=catalogue,
+    res = campaign.campaign(40, directory=tmp_path / "work", catalogue=catalogue,
                          profile=tmp_path / "campaign.prof")
     assert res["runs"] == 2 * res["levels"] * res["n_mu"] * res["n_slenderness"] >= 40
     assert res["failed_runs"] == 0
@@ -106,7 +106,7 @@ def test_campaign_report_states_targets_only_for_a_full_campaign():
          "memory": {"imports": 250e6, "warmup": 350e6, "before": 350e6, "peak": 380e6,
                     "increase": 30e6, "peak_reset": True}}
     out = io.StringIO()
-    bench._write_campaign(out, c)
+    campaign.write_campaign(out, c)
     text = out.getvalue()
     assert "applies to 100000 runs" in text and "NOT met" not in text
     assert "the campaign added 30 MB" in text
@@ -114,7 +114,7 @@ def test_campaign_report_states_targets_only_for_a_full_campaign():
     profile = {"total": 210.0, "kernel": 190.0,
                "stages": {"batch": 195.0, "records": 1.0, "fits": 3.0, "netcdf_write": 0.5,
                           "netcdf_read": 0.2}}
-    bench._write_campaign(out, {**c, "runs": 100_122, "seconds": 200.0, "profile": profile})
+    campaign.write_campaign(out, {**c, "runs": 100_122, "seconds": 200.0, "profile": profile})
     text = out.getvalue()
     assert "(target 120 s: NOT met)" in text and "(target 200 MB: met)" in text
     assert "90.5 % of the profiled time in compiled kernels" in text
@@ -144,7 +144,7 @@ def test_samples_counted_stop_where_a_run_fails():
                              mu_k_ship=0.8)
     summ = simulate_batch(system, [(pulse, None), (quiet, None)], dt, [(0, 0, 1, 1), (1, 0, 1, 1)])
     assert summ["failure"][0] != 0 and summ["failure"][1] == 0
-    n = bench.integrated_samples(summ, np.array([dt, dt]))
+    n = timing.integrated_samples(summ, np.array([dt, dt]))
     failed_at = summ["failure_time"][0]
     assert n == pytest.approx(failed_at / dt + 1 + t.size, rel=1e-12)
     assert n < 1.5 * t.size  # not the 2 x 2000 input samples
@@ -164,7 +164,7 @@ def test_interleaved_times_alternate_the_calls_on_their_threads():
 
     before = numba.get_num_threads()
     n = numba.config.NUMBA_NUM_THREADS
-    times, results = bench.interleaved_times([(1, probe("a")), (n, probe("b"))], 0.0,
+    times, results = timing.interleaved_times([(1, probe("a")), (n, probe("b"))], 0.0,
                                              min_rounds=3)
     assert times.shape == (3, 2) and np.all(times >= 0)
     assert calls_seen == [("a", 1), ("b", n)] * 3
@@ -178,7 +178,7 @@ def test_control_loop_lasts_about_what_was_asked():
 
     import numba
 
-    loop = bench.control_loop(0.02)
+    loop = timing.control_loop(0.02)
     threads = numba.get_num_threads()
     numba.set_num_threads(1)
     try:
@@ -197,7 +197,7 @@ def test_throughput_reports_best_and_median_of_its_window():
     dt = 0.01
     t = np.arange(1500) * dt
     records = [("sine", 3.0 * np.sin(2 * np.pi * t), 0.3 * np.sin(3 * np.pi * t), dt)]
-    r = bench.throughput(bench.rocking_system(), records, scale=1.0, min_seconds=0.05)
+    r = solver.throughput(timing.rocking_system(), records, scale=1.0, min_seconds=0.05)
     assert r["rounds"] >= 5
     assert r["samples_per_s"] == pytest.approx(r["samples"] / r["seconds"])
     assert r["samples_per_s"] >= r["samples_per_s_median"] > 0
@@ -214,5 +214,5 @@ def test_throughput_reports_best_and_median_of_its_window():
     (1.6, 1.5, "NOT met, nor did the control loop: the machine allowed no more in this window"),
 ])
 def test_scaling_verdict_says_when_the_machine_missed_too(batch, machine, expected):
-    got = bench.scaling_verdict({"speedup": batch, "machine_speedup": machine}, target=1.8)
+    got = targets.scaling_verdict({"speedup": batch, "machine_speedup": machine}, target=1.8)
     assert got == expected

@@ -7,12 +7,12 @@ import time
 import numpy as np
 import pytest
 
-from shipblock import bench_parallel, bench_startup
+from shipblock.bench import parallel, startup
 from shipblock.cli import main
 
 
 def test_busy_process_keeps_a_core_busy_and_ends():
-    with bench_parallel.busy_process() as proc:
+    with parallel.busy_process() as proc:
         assert proc.poll() is None  # running
         t0 = time.process_time()
         time.sleep(0.2)
@@ -28,7 +28,7 @@ def test_busy_core_rows_are_reported_with_a_verdict():
              "seconds_n": 6e-3, "median_1": 6.2e-3, "median_n": 8.0e-3, "rounds": 40,
              "identical": True}]
     out = io.StringIO()
-    bench_parallel.write_busy_core(out, rows)
+    parallel.write_busy_core(out, rows)
     lines = out.getvalue().splitlines()
     assert len(lines) == 2
     assert lines[0].endswith("never slower: met)")
@@ -36,7 +36,7 @@ def test_busy_core_rows_are_reported_with_a_verdict():
 
 
 def test_busy_core_batch_measures_both_conditions():
-    rows = bench_parallel.busy_core_batch(min_seconds=0.0, copies=(1,))
+    rows = parallel.busy_core_batch(min_seconds=0.0, copies=(1,))
     assert [r["busy"] for r in rows] == [False, True]
     for r in rows:
         assert r["identical"] and r["rounds"] >= 3
@@ -51,26 +51,26 @@ def test_cold_start_report():
                        "compiled": {"the intensity measures": 0.3}},
          "target": 30.0, "load_average_before": (0.2, 0.3, 0.4), "load_average_after": None}
     out = io.StringIO()
-    bench_startup.write_cold_start(out, c)
+    startup.write_cold_start(out, c)
     text = out.getvalue()
     assert "21.0 s" in text and "the solver 16.9 s" in text and "target 30 s: met" in text
     assert "the intensity measures 0.30 s" in text
     out = io.StringIO()
-    bench_startup.write_cold_start(out, {**c, "cold": {**c["cold"], "wall": 31.0}})
+    startup.write_cold_start(out, {**c, "cold": {**c["cold"], "wall": 31.0}})
     assert "NOT met" in out.getvalue()
     out = io.StringIO()
-    bench_startup.write_cold_start(out, None)
+    startup.write_cold_start(out, None)
     assert "skipped" in out.getvalue()
 
 
 def test_cold_start_child_reports_what_compiled(tmp_path):
     """The child process of the cold start: exit code, CPU time, compile time by part."""
-    result = bench_startup.run_command(["info", "--record", "NP.1765"], tmp_path / "cache",
+    result = startup.run_command(["info", "--record", "NP.1765"], tmp_path / "cache",
                                        tmp_path)
     assert result["code"] == 0 and result["wall"] > 0 and result["cpu"] > 0
     # an empty cache: the intensity measures compile, nothing of the solver
     assert set(result["compiled"]) == {"the intensity measures"}
-    again = bench_startup.run_command(["info", "--record", "NP.1765"], tmp_path / "cache",
+    again = startup.run_command(["info", "--record", "NP.1765"], tmp_path / "cache",
                                       tmp_path)
     assert again["compiled"] == {}  # loaded from the cache filled by the first run
 
@@ -83,13 +83,13 @@ def test_dask_report():
     d = {"runs": {"runs": 3000, "bootstrap": 0, "clusters": clusters, "scaling": 5.0 / 3.0,
                   "local": {"seconds": 4.0, "runs_per_s": 750.0, "stages": {"runs": 2.5}}}}
     out = io.StringIO()
-    bench_parallel.write_dask_scaling(out, d)
+    parallel.write_dask_scaling(out, d)
     text = out.getvalue()
     assert "pipeline 'runs' of 3000 runs (solver part)" in text
     assert "identical to the local run" in text and "DIFFERENT from the local run" in text
     assert "scaling from 1 to 2 workers: 1.67x" in text
     out = io.StringIO()
-    bench_parallel.write_dask_scaling(out, None)
+    parallel.write_dask_scaling(out, None)
     assert "not installed" in out.getvalue()
 
 
@@ -106,9 +106,9 @@ def test_same_results_ignores_only_the_time_stamp():
     a = xr.Dataset({"x": ("i", np.array([1.0, np.nan]))}, attrs={"created": "t0", "k": 1})
     b = a.copy(deep=True)
     b.attrs["created"] = "t1"
-    assert bench_parallel._same_results(a, b)
+    assert parallel._same_results(a, b)
     b["x"].values[0] = 1.0 + 1e-15
-    assert not bench_parallel._same_results(a, b)
+    assert not parallel._same_results(a, b)
     c = a.copy(deep=True)
     c.attrs["k"] = 2
-    assert not bench_parallel._same_results(a, c)
+    assert not parallel._same_results(a, c)

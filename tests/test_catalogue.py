@@ -1,4 +1,4 @@
-"""Tests of the shipped record catalogue (records/catalogue.toml) and shipblock.catalogue.
+"""Tests of the shipped record catalogue (records/catalogue.toml) and shipblock.records.catalogue.
 
 Reference values: PGA table of records/south-napa-2014/README.md (2014 South Napa Mw 6.0, USGS
 NSMP network NP, event nc72282711): PGA after ``detrend('demean')`` and ``remove_sensitivity``
@@ -12,9 +12,9 @@ import hashlib
 import numpy as np
 import pytest
 
-from shipblock.catalogue import default_catalogue_path, load_catalogue
+from shipblock.records.catalogue import default_catalogue_path, load_catalogue
 from shipblock.errors import RecordError
-from shipblock.motion import COMPONENT_KEY
+from shipblock.records.motion import COMPONENT_KEY
 
 #: README table "PGA of each component" [m/s^2]: station -> (H1 = HNN, H2 = HNE, V = HNZ).
 README_PGA = {

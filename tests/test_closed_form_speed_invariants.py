@@ -28,7 +28,7 @@ from shipblock.solver._layout import (
     W_NOTED,
     parameter_tuple,
 )
-from shipblock.solver._load_peaks import note_span_extremes
+from shipblock.solver._running_peaks import note_span_extremes
 from shipblock.system import P_B, P_G, P_H, P_MUS1, P_MUS2
 
 

@@ -82,7 +82,7 @@ CASES = {
 
 
 def _motion(dt=0.01):
-    from shipblock.motion import GroundMotion
+    from shipblock.records.motion import GroundMotion
 
     return GroundMotion.from_arrays(ACC, None, dt=dt, name="sine")
 
@@ -348,10 +348,11 @@ HELENA = [str(DATA / f"helena_synthetic_{c}.AT2") for c in ("180", "270", "dwn")
 
 
 def _reader_calls():
-    from shipblock.catalogue import catalogue_toml, default_catalogue_path, load_catalogue
-    from shipblock.collection import expand_sources, read_motions
     from shipblock.io import read_record
-    from shipblock.motion import GroundMotion, read_motion, rotate_to_azimuth
+    from shipblock.records.catalogue import catalogue_toml, default_catalogue_path, load_catalogue
+    from shipblock.records.folders import expand_sources, read_motions
+    from shipblock.records.motion import GroundMotion, rotate_to_azimuth
+    from shipblock.records.reading import read_motion
 
     acc = 2.0 * np.sin(np.linspace(0.0, 20.0, 400))
     acc2 = np.cos(np.linspace(0.0, 20.0, 400))
@@ -400,7 +401,7 @@ def test_every_reader_entry_point_accepts_or_names_a_bad_argument(function, tmp_
     gives a good result or a shipblock error (or TypeError) whose message names the argument."""
     from obspy import Stream
 
-    from shipblock.motion import GroundMotion
+    from shipblock.records.motion import GroundMotion
 
     monkeypatch.chdir(tmp_path)  # 'abc' or 'furlongs' must name no file
     fn, good = _reader_calls()[function]
@@ -523,13 +524,13 @@ _HELENA = object()
 
 
 def _read(source=_HELENA, **kwargs):
-    from shipblock.motion import read_motion
+    from shipblock.records.reading import read_motion
 
     return read_motion(HELENA if source is _HELENA else source, **kwargs)
 
 
 def _read_all(source=HELENA, **kwargs):
-    from shipblock.collection import read_motions
+    from shipblock.records.folders import read_motions
 
     return read_motions(source, **kwargs)
 
@@ -541,25 +542,25 @@ def _record(path, **kwargs):
 
 
 def _catalogue(path):
-    from shipblock.catalogue import load_catalogue
+    from shipblock.records.catalogue import load_catalogue
 
     return load_catalogue(path)
 
 
 def _entry():
-    from shipblock.catalogue import load_catalogue
+    from shipblock.records.catalogue import load_catalogue
 
     return load_catalogue()["south-napa-2014/NP.1737"]
 
 
 def _arrays(horizontal, vertical=None, **kwargs):
-    from shipblock.motion import GroundMotion
+    from shipblock.records.motion import GroundMotion
 
     return GroundMotion.from_arrays(horizontal, vertical, **kwargs)
 
 
 def _gm_class():
-    from shipblock.motion import GroundMotion
+    from shipblock.records.motion import GroundMotion
 
     return GroundMotion
 
@@ -567,7 +568,7 @@ def _gm_class():
 def _stream_of(data, delta=0.01):
     from obspy import Stream, Trace
 
-    from shipblock.motion import COMPONENT_KEY
+    from shipblock.records.motion import COMPONENT_KEY
 
     trace = Trace(np.asarray(data, dtype=float))
     trace.stats.delta = delta

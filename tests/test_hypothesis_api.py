@@ -30,14 +30,14 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from shipblock import ShipBlockSystem, simulate, simulate_batch
-from shipblock.catalogue import load_catalogue
+from shipblock.records.catalogue import load_catalogue
 from shipblock.checks import MAX_ACCELERATION, MAX_TIME_STEP, MIN_TIME_STEP
 from shipblock.errors import ParameterError, RecordError, ShipblockError
 from shipblock.io import read_record
-from shipblock.io._common import canonical_unit, canonical_velocity_unit
-from shipblock.motion import GroundMotion, read_motion, rotate_to_azimuth
+from shipblock.records.motion import GroundMotion, rotate_to_azimuth
+from shipblock.records.reading import read_motion
 from shipblock.system import FIELD_LIMITS, MIN_INERTIA_RATIO
-from shipblock.units import ACCELERATION_UNITS_TO_SI
+from shipblock.units import ACCELERATION_UNITS_TO_SI, canonical_unit, canonical_velocity_unit
 
 SETTINGS = settings(max_examples=300, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow])

@@ -5,7 +5,7 @@ groundmotion-processing repository, byte for byte: the text, integer and real he
 and the data descriptor line. The samples (42000 a file, 380-680 KB) are not stored. Each test
 rebuilds a file from the agency's header, synthetic samples in the format the descriptor gives, and
 the agency's ``End-of-data`` line. It then reads the file with ``obspy.read`` (format found through
-the entry points) and with :func:`shipblock.motion.read_motion`.
+the entry points) and with :func:`shipblock.records.reading.read_motion`.
 
 Expected values come from the header itself: npts from the descriptor line, dt from Real(62) [ms],
 start time from Int(40), Int(42)-Int(45) and Real(30) (and text line 8, printed to 1 ms),
@@ -26,7 +26,7 @@ import obspy
 import pytest
 
 from shipblock.errors import RecordError, UnitsError
-from shipblock.motion import read_motion
+from shipblock.records.reading import read_motion
 
 REAL = Path(__file__).parent / "data" / "real" / "cosmos"
 CM = 0.01  # 1 cm/s^2 = 0.01 m/s^2 (exact)

@@ -149,7 +149,7 @@ def test_every_documented_summary_variable_except_failure_time_is_an_edp():
         "uplift",
         "n_impacts",
         "failure",
-        # contact loads per block (shipblock.loads)
+        # contact loads per block (shipblock.interface_forces)
         "peak_ground_normal_force",
         "peak_ground_friction_force",
         "peak_ship_normal_force",

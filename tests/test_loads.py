@@ -14,7 +14,7 @@ import pytest
 
 from shipblock import ShipBlockSystem, simulate, simulate_batch
 from shipblock.fragility.limit_states import LimitState, exceedance
-from shipblock.loads import LOAD_FIELDS
+from shipblock.interface_forces import LOAD_FIELDS
 from shipblock.units import STANDARD_GRAVITY as G
 
 try:

@@ -1,4 +1,4 @@
-"""Tests of shipblock.motion: units, components, rotation, alignment and bad input.
+"""Tests of shipblock.records.motion: units, components, rotation, alignment and bad input.
 
 Reference values: the South Napa 2014 PGA table of records/south-napa-2014/README.md (USGS NSMP
 records, computed there with obspy 1.5.1: demean, remove_sensitivity, max |a|); K-NET header
@@ -18,7 +18,8 @@ import pytest
 from obspy import Stream, Trace, UTCDateTime
 
 from shipblock.errors import ParameterError, RecordError, UnitsError
-from shipblock.motion import COMPONENT_KEY, GroundMotion, read_motion, rotate_to_azimuth
+from shipblock.records.motion import COMPONENT_KEY, GroundMotion, rotate_to_azimuth
+from shipblock.records.reading import read_motion
 
 DATA = Path(__file__).parent / "data"
 NAPA = Path(__file__).parent.parent / "records" / "south-napa-2014"

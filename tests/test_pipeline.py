@@ -21,7 +21,7 @@ import xarray as xr
 
 import shipblock
 from shipblock import simulate
-from shipblock.catalogue import load_catalogue
+from shipblock.records.catalogue import load_catalogue
 from shipblock.fragility.fit import fit_ida
 from shipblock.fragility.pipeline import (
     PipelineError,

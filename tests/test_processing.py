@@ -293,8 +293,8 @@ def test_chain_errors_name_step_and_parameter(noisy, chain, step, parameter):
 
 
 def test_process_motion_returns_new_ground_motion():
-    """Integration with shipblock.motion: tags, metadata note and purity."""
-    from shipblock.motion import GroundMotion
+    """Integration with shipblock.records.motion: tags, metadata note and purity."""
+    from shipblock.records.motion import GroundMotion
 
     rng = np.random.default_rng(11)
     gm = GroundMotion.from_arrays(rng.standard_normal(3000), rng.standard_normal(3000), dt=0.01)

@@ -21,11 +21,11 @@ import numpy as np
 import obspy
 import pytest
 
-from shipblock.catalogue import load_catalogue
-from shipblock.collection import read_motions
+from shipblock.records.catalogue import load_catalogue
+from shipblock.records.folders import read_motions
 from shipblock.errors import RecordError
 from shipblock.io import read_record
-from shipblock.motion import read_motion
+from shipblock.records.reading import read_motion
 
 NAPA = Path(__file__).parent.parent / "records" / "south-napa-2014"
 RECORD = 4096  # record length of the shipped files [bytes]

@@ -2,7 +2,7 @@
 
 Every case reads a file whose one header field holds an absurd, a damaged or simply another value
 (:func:`tests.reader_fuzz.sac_field_mutations`, :func:`tests.reader_fuzz.stationxml_field_mutations`,
-plus a few hypothesis-drawn floats), through :func:`shipblock.motion.read_motion`. The test knows
+plus a few hypothesis-drawn floats), through :func:`shipblock.records.reading.read_motion`. The test knows
 what a correct read of each file is, from the formats' definitions (SAC: samples x SCALE in the
 unit of KUSER0 or IDEP, IACC = nm/s^2; time of the first sample = reference time + B; StationXML:
 counts / sensitivity in the sensitivity's input unit), and requires either exactly that, or a
@@ -29,7 +29,7 @@ from hypothesis import strategies as st
 from obspy import Trace, UTCDateTime
 
 from shipblock.errors import ShipblockError
-from shipblock.motion import read_motion
+from shipblock.records.reading import read_motion
 from tests.reader_fuzz import (
     sac_field_mutations,
     sac_patch,

@@ -20,7 +20,7 @@ from shipblock.io.at2 import read_at2
 from shipblock.io.cosmos import read_cosmos
 from shipblock.io.esm import read_esm
 from shipblock.io.text import read_text_record
-from shipblock.motion import read_motion
+from shipblock.records.reading import read_motion
 from tests.test_io_formats import H1_CM, _cosmos_block, _esm_text
 
 DATA = Path(__file__).parent / "data"

@@ -13,12 +13,12 @@ import numpy as np
 import obspy
 import pytest
 
-from shipblock.catalogue import load_catalogue
+from shipblock.records.catalogue import load_catalogue
 from shipblock.cli import main
-from shipblock.collection import read_motions
+from shipblock.records.folders import read_motions
 from shipblock.errors import ParameterError, RecordError, UnitsError
 from shipblock.io import read_record
-from shipblock.motion import read_motion
+from shipblock.records.reading import read_motion
 from shipblock.units import STANDARD_GRAVITY
 from tests.real_corpus import assert_peaks_match_gmprocess, corpus_file, reference_files
 

@@ -169,8 +169,8 @@ def test_zero_record_cannot_reach_target(record):
 
 
 def test_scale_motion_integration(record):
-    """Integration with shipblock.motion: PGA target reached on the solver's horizontal."""
-    from shipblock.motion import GroundMotion
+    """Integration with shipblock.records.motion: PGA target reached on the solver's horizontal."""
+    from shipblock.records.motion import GroundMotion
     from shipblock.scaling import scale_motion
 
     h, v = record

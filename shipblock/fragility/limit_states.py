@@ -44,7 +44,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from shipblock.errors import ParameterError
-from shipblock.loads import LOAD_FIELDS
+from shipblock.interface_forces import LOAD_FIELDS
 
 __all__ = [
     "CONDITIONS",

@@ -636,7 +636,7 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
         Naming the key: unknown key, wrong type, missing section or key, invalid value,
         unknown record id, invalid system, limit state or design.
     """
-    from shipblock.catalogue import load_catalogue
+    from shipblock.records.catalogue import load_catalogue
 
     base = Path(base)
     try:
@@ -1555,7 +1555,7 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         are found before the batch starts.
     """
     from shipblock import __version__
-    from shipblock.catalogue import load_catalogue
+    from shipblock.records.catalogue import load_catalogue
     from shipblock.processing import DEFAULT_CHAIN
 
     for name, value, types, what in (("output", output, str | os.PathLike, "a file path"),
@@ -1733,7 +1733,7 @@ def rerun_case(path, record: str, *, im_level=None, im_level_g=None, **sweep):
 
 def _rerun(path, record, im_level=None, im_level_g=None, **sweep):
     """Run one case of a pipeline; returns ``(dataset of the run, result)``."""
-    from shipblock.catalogue import load_catalogue
+    from shipblock.records.catalogue import load_catalogue
 
     pipe = load_pipeline(path)
     design = pipe.design

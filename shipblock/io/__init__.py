@@ -45,6 +45,8 @@ from shipblock import checks
 from shipblock.errors import ParameterError, ParameterTypeError, RecordError, ShipblockError
 from shipblock.io import at2, bhrc, cosmos, cwb, dmg, esm, geonet, nsmn, renadic, smc, text, unam, usc
 from shipblock.io._common import (
+    MAX_DIGITIZATION_GAP_S,
+    check_count_value,
     check_plausible_samples,
     check_sampling_interval,
     check_start_time,
@@ -52,7 +54,18 @@ from shipblock.io._common import (
 )
 from shipblock.io.knet import normalise_knet
 
-__all__ = ["FORMATS", "check_format", "known_formats", "read_record"]
+# The reader entry points, and the checks of a record's numbers that the readers share and
+# shipblock.records applies to the traces it converts.
+__all__ = [
+    "FORMATS",
+    "MAX_DIGITIZATION_GAP_S",
+    "check_count_value",
+    "check_format",
+    "check_plausible_samples",
+    "check_sampling_interval",
+    "known_formats",
+    "read_record",
+]
 
 #: Words of a reader's warning that mean the file is damaged: libmseed's reports (truncated
 #: records, Steim integrity checks) and truncation notices. A damaged file is refused rather than

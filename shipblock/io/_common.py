@@ -16,8 +16,7 @@ import numpy as np
 from obspy import Trace, UTCDateTime
 
 from shipblock.checks import MAX_ACCELERATION, MAX_TIME_STEP, MIN_TIME_STEP
-from shipblock.errors import RecordError, UnitsError
-from shipblock.units import ACCELERATION_UNITS_TO_SI, VELOCITY_UNITS_TO_SI
+from shipblock.errors import RecordError
 
 #: Number of bytes read by the format-detection functions [bytes].
 PEEK_BYTES = 8192
@@ -58,43 +57,6 @@ MAX_DIGITIZATION_GAP_S = 0.25
 
 #: A floating-point number as written by Fortran or C (``1.0``, ``-.25E-03``, ``3``, ``1.2D+01``).
 FLOAT_RE = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?")
-
-#: Accepted spellings of acceleration units, mapped to the keys of
-#: :data:`shipblock.units.ACCELERATION_UNITS_TO_SI`.
-UNIT_ALIASES: dict[str, str] = {
-    "g": "g",
-    "g's": "g",
-    "gs": "g",
-    "g'": "g",
-    "gal": "gal",
-    "gals": "gal",
-    "cm/s^2": "cm/s^2",
-    "cm/s**2": "cm/s^2",
-    "cm/s/s": "cm/s^2",
-    "cm/s2": "cm/s^2",
-    "cm/sec^2": "cm/s^2",
-    "cm/sec2": "cm/s^2",
-    "cm/sec/sec": "cm/s^2",
-    "cm/sec**2": "cm/s^2",
-    "m/s^2": "m/s^2",
-    "m/s**2": "m/s^2",
-    "m/s/s": "m/s^2",
-    "m/s2": "m/s^2",
-    "m/sec^2": "m/s^2",
-    "m/sec2": "m/s^2",
-    "m/sec/sec": "m/s^2",
-    "mm/s^2": "mm/s^2",
-    "mm/s**2": "mm/s^2",
-    "mm/s/s": "mm/s^2",
-    "mm/s2": "mm/s^2",
-    "nm/s^2": "nm/s^2",
-    "nm/s**2": "nm/s^2",
-    "nm/s/s": "nm/s^2",
-    "nm/s2": "nm/s^2",
-    "m/(s**2)": "m/s^2",
-    "m/sec**2": "m/s^2",
-}
-
 
 def source_name(source) -> str:
     """Return a printable name for a path or file object.
@@ -294,58 +256,6 @@ def parse_free_floats(lines, name: str, what: str) -> np.ndarray:
                     name, f"{what}: {token!r} is not a number (data line {lineno})"
                 ) from None
     return np.asarray(values, dtype=np.float64)
-
-
-def canonical_unit(unit: str) -> str | None:
-    """Map a spelling of an acceleration unit to a key of the SI conversion table.
-
-    Parameters
-    ----------
-    unit : str
-        For example ``"g"``, ``"G's"``, ``"cm/sec2"``, ``"gal"``, ``"m/s^2"``.
-
-    Returns
-    -------
-    str or None
-        A key of :data:`shipblock.units.ACCELERATION_UNITS_TO_SI`, or ``None`` if unknown.
-    """
-    key = unit.strip().lower().replace(" ", "")
-    key = UNIT_ALIASES.get(key, key)
-    return key if key in ACCELERATION_UNITS_TO_SI else None
-
-
-def canonical_velocity_unit(unit: str | None) -> str | None:
-    """Map a spelling of a velocity unit (``"M/S"``, ``"cm/sec"``) to a key of
-    :data:`shipblock.units.VELOCITY_UNITS_TO_SI`, or ``None`` if it is not one."""
-    key = (unit or "").strip().lower().replace(" ", "").replace("sec", "s")
-    return key if key in VELOCITY_UNITS_TO_SI else None
-
-
-def si_factor(unit: str, name: str) -> float:
-    """Return the factor that converts ``unit`` to m/s^2.
-
-    Parameters
-    ----------
-    unit : str
-        An acceleration unit (any spelling accepted by :func:`canonical_unit`).
-    name : str
-        File name, for the error message.
-
-    Returns
-    -------
-    float
-        Conversion factor [m/s^2 per unit].
-
-    Raises
-    ------
-    UnitsError
-        If the unit is not a known acceleration unit.
-    """
-    key = canonical_unit(unit)
-    if key is None:
-        known = ", ".join(sorted(set(UNIT_ALIASES.values())))
-        raise UnitsError(name, f"unknown acceleration unit {unit!r}; known units: {known}")
-    return ACCELERATION_UNITS_TO_SI[key]
 
 
 def check_samples(data: np.ndarray, name: str, what: str) -> None:

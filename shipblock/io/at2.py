@@ -37,8 +37,6 @@ from obspy.core import AttribDict
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
-    canonical_unit,
-    canonical_velocity_unit,
     check_plausible_samples,
     check_samples,
     check_sampling_interval,
@@ -48,7 +46,13 @@ from shipblock.io._common import (
     read_text,
     source_name,
 )
-from shipblock.units import ACCELERATION_UNITS_TO_SI, INCH, STANDARD_GRAVITY
+from shipblock.units import (
+    ACCELERATION_UNITS_TO_SI,
+    INCH,
+    STANDARD_GRAVITY,
+    canonical_unit,
+    canonical_velocity_unit,
+)
 
 __all__ = ["FORMAT", "is_at2", "read_at2"]
 
@@ -73,7 +77,7 @@ _PAREN_RE = re.compile(r"\(([A-Z/*^0-9'% ]+)\)", re.IGNORECASE)
 #: One foot [m] (international foot, 1959).
 FOOT = 0.3048
 
-#: Acceleration units the AT2 reader knows beyond :func:`shipblock.io._common.canonical_unit`
+#: Acceleration units the AT2 reader knows beyond :func:`shipblock.units.canonical_unit`
 #: (normalised spelling, see :func:`_normalise`) -> factor to m/s^2. ``km/s^2`` is a real unit
 #: (1000 m/s^2) and is converted; the 100 g plausibility check catches a file whose numbers are
 #: not what the header says.

@@ -72,11 +72,10 @@ from shipblock.io._common import (
     parse_float,
     peek_text,
     read_text,
-    si_factor,
     source_name,
     utc_time,
 )
-from shipblock.units import STANDARD_GRAVITY
+from shipblock.units import STANDARD_GRAVITY, si_factor
 
 __all__ = ["FORMAT", "is_bhrc", "read_bhrc"]
 
@@ -161,7 +160,7 @@ def is_bhrc(filename) -> bool:
 
 
 def _units(unit: str, name: str) -> float:
-    """Return m/s^2 per unit of the samples (``G/10``, or any unit :func:`si_factor` knows)."""
+    """Return m/s^2 per unit of the samples (``G/10``, or any unit :func:`~shipblock.units.si_factor` knows)."""
     if unit.upper() == "G/10":
         return G_OVER_10_SI
     return si_factor(unit, name)

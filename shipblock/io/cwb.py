@@ -64,9 +64,9 @@ from shipblock.io._common import (
     parse_number,
     peek_text,
     read_text,
-    si_factor,
     source_name,
 )
+from shipblock.units import si_factor
 
 __all__ = ["FORMAT", "is_cwb", "read_cwb"]
 

@@ -89,7 +89,6 @@ from obspy.core import AttribDict
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
-    canonical_unit,
     check_plausible_samples,
     check_samples,
     check_sampling_interval,
@@ -99,10 +98,9 @@ from shipblock.io._common import (
     parse_float,
     peek_text,
     read_text,
-    si_factor,
     source_name,
 )
-from shipblock.units import STANDARD_GRAVITY
+from shipblock.units import STANDARD_GRAVITY, canonical_unit, si_factor
 
 __all__ = ["FORMAT", "is_dmg", "read_dmg"]
 

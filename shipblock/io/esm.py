@@ -55,9 +55,9 @@ from shipblock.io._common import (
     parse_free_floats,
     peek_text,
     read_text,
-    si_factor,
     source_name,
 )
+from shipblock.units import si_factor
 
 __all__ = ["FORMAT", "is_esm", "read_esm"]
 

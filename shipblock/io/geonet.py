@@ -58,7 +58,6 @@ from obspy.core import AttribDict
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
-    canonical_unit,
     check_plausible_samples,
     check_samples,
     check_sampling_interval,
@@ -67,10 +66,10 @@ from shipblock.io._common import (
     orientation_stats,
     peek_text,
     read_text,
-    si_factor,
     source_name,
     utc_time,
 )
+from shipblock.units import canonical_unit, si_factor
 
 __all__ = ["FORMAT", "is_geonet", "read_geonet"]
 

@@ -81,10 +81,10 @@ from shipblock.io._common import (
     parse_number,
     peek_text,
     read_text,
-    si_factor,
     source_name,
     utc_time,
 )
+from shipblock.units import si_factor
 
 __all__ = ["FORMAT", "is_renadic", "read_renadic"]
 

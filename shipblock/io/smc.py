@@ -78,9 +78,9 @@ from shipblock.io._common import (
     peek_text,
     read_text,
     resample_pairs,
-    si_factor,
     source_name,
 )
+from shipblock.units import si_factor
 
 __all__ = ["FORMAT", "is_smc", "read_smc"]
 

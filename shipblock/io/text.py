@@ -24,7 +24,6 @@ from obspy.core import AttribDict
 
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
-    canonical_unit,
     check_plausible_samples,
     check_samples,
     check_sampling_interval,
@@ -32,9 +31,9 @@ from shipblock.io._common import (
     parse_float,
     peek_text,
     read_text,
-    si_factor,
     source_name,
 )
+from shipblock.units import canonical_unit, si_factor
 
 __all__ = ["FORMAT", "TIME_STEP_TOLERANCE", "is_text", "read_text_record"]
 
@@ -105,7 +104,7 @@ def header_units(header_lines) -> str | None:
     Returns
     -------
     str or None
-        The canonical unit key (see :func:`shipblock.io._common.canonical_unit`), or ``None``.
+        The canonical unit key (see :func:`shipblock.units.canonical_unit`), or ``None``.
 
     Raises
     ------

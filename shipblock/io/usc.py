@@ -70,7 +70,6 @@ from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     DEFAULT_RESAMPLE_RATE_HZ,
     FLOAT_RE,
-    canonical_unit,
     check_plausible_samples,
     check_samples,
     check_sampling_interval,
@@ -82,10 +81,9 @@ from shipblock.io._common import (
     peek_text,
     read_text,
     resample_pairs,
-    si_factor,
     source_name,
 )
-from shipblock.units import STANDARD_GRAVITY
+from shipblock.units import STANDARD_GRAVITY, canonical_unit, si_factor
 
 __all__ = ["FORMAT", "is_usc", "read_usc"]
 

@@ -93,7 +93,7 @@ def _run_cases_in_new_work(*args) -> None:
 
 
 def _is_motion(value) -> bool:
-    """Whether ``value`` is a :class:`shipblock.motion.GroundMotion` (without importing obspy)."""
+    """Whether ``value`` is a :class:`shipblock.records.motion.GroundMotion` (without importing obspy)."""
     return all(hasattr(value, a) for a in ("horizontal", "vertical", "dt"))
 
 
@@ -123,7 +123,7 @@ def simulate(
     ax : array_like or GroundMotion
         Horizontal ground acceleration at ``t_k = k dt`` [m/s^2], positive to the right; at
         least 2 samples, each finite and within :data:`shipblock.checks.MAX_ACCELERATION`
-        (100 g). A :class:`shipblock.motion.GroundMotion` may be passed instead, in which case
+        (100 g). A :class:`shipblock.records.motion.GroundMotion` may be passed instead, in which case
         its horizontal, vertical and dt are used (``ay`` and ``dt`` are then not given).
     ay : array_like or None, optional
         Vertical ground acceleration [m/s^2], positive up; ``None`` for none. Same length and

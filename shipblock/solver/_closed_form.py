@@ -88,7 +88,7 @@ from shipblock.solver._layout import (
     Y_XB,
     Y_XS,
 )
-from shipblock.solver._load_peaks import (
+from shipblock.solver._running_peaks import (
     folds_loads,
     note_span_extremes,
 )

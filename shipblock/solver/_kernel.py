@@ -141,7 +141,7 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     Y_XS,
     parameter_tuple,
 )
-from shipblock.solver._loads import note_loads, span_loads, state_loads
+from shipblock.solver._force_sampling import note_loads, span_loads, state_loads
 from shipblock.solver._stuck_rocking import (
     advance_stuck,
     is_stuck_rocking,

@@ -57,7 +57,7 @@ S_IMPACT_LOSS = 21
 S_N_JAMS = 22  # jams of a slipping interface (Painleve regime)
 S_ENERGY_FINAL = 23  # T + V at the end
 S_PEAK_TH_TIME = 24
-# Peak contact loads (see shipblock.solver._loads): interface forces, totals over the n blocks
+# Peak contact loads (see shipblock.solver._force_sampling): interface forces, totals over the n blocks
 # [N], and friction utilisations [-].
 S_PEAK_FY = 25  # ground on blocks, normal
 S_PEAK_FX = 26  # ground on blocks, |friction|
@@ -85,7 +85,7 @@ W_INV_WR = W_INV_W + 2  # 1 / (weight R)
 # holds surely hold without a vertical input (see ``held_interval``), set with its response
 W_HELD = W_INV_W + 3
 # per response slot, the range [lo, hi] of scaled horizontal input whose contact loads have been
-# noted in the run's peaks (see ``note_span_extremes`` in shipblock.solver._load_peaks), set
+# noted in the run's peaks (see ``note_span_extremes`` in shipblock.solver._running_peaks), set
 # empty (inf, -inf) with its response vectors
 W_NOTED = W_HELD + 2 * N_RESP_SLOTS
 # 1 if the last span noted its contact loads itself, 0 if span_loads is to scan them

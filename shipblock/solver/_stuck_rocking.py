@@ -71,7 +71,7 @@ from shipblock.solver._layout import (
     Y_XB,
     Y_XS,
 )
-from shipblock.solver._loads import note_loads
+from shipblock.solver._force_sampling import note_loads
 from shipblock.system import P_G, P_M, P_NM, P_R
 
 #: Largest |delta| [rad] for the series of :func:`small_angle_sincos` (truncation below 1e-17

@@ -40,7 +40,7 @@ constant horizontal acceleration :math:`a` below slip the friction forces are
 :math:`\mu_k/\mu_s`. Utilisation 1 is the onset of slip: a run that never slid shows how close
 it came.
 
-The peaks are kept by the compiled solver (:mod:`shipblock.solver._loads`) between the samples
+The peaks are kept by the compiled solver (:mod:`shipblock.solver._force_sampling`) between the samples
 too: exactly in rest and sliding (the forces are linear between samples there), at every
 integration step's end and on both sides of every event while rocking (steps of at most one
 sample; tests/test_loads.py measures the remaining error against the same run on a ten times

@@ -1,19 +1,19 @@
 """Cold start: the README's demo command from an empty numba cache, as a new user meets it.
 
-Part of ``shipblock bench`` (:func:`shipblock.bench.run_benchmarks`). Each command runs in a
+Part of ``shipblock bench`` (:func:`shipblock.bench.run.run_benchmarks`). Each command runs in a
 fresh Python process whose numba cache is a new, empty directory (``NUMBA_CACHE_DIR``), so
 that everything the command needs is compiled, as after a fresh install; then again with that
-cache filled. The child process measures how long numba compiled each part (the solver, the
-intensity measures: :func:`shipblock.cli.compiled_part`) with the command line's own compile
-notice (:func:`shipblock.cli.compile_notice`); the parent measures the wall time of the whole
-process, interpreter start included.
+cache filled. The child process, the command line with ``--compile-report``, measures how long
+numba compiled each part (the solver, the intensity measures: :func:`shipblock.cli.compiled_part`)
+with its own compile notice (:func:`shipblock.cli.compile_notice`); the parent measures the wall
+time of the whole process, interpreter start included. The benchmark runs the command line as a
+program and does not import it: the command line imports the benchmarks (``shipblock bench``).
 """
 
 from __future__ import annotations
 
 import json
 import os
-import resource
 import subprocess
 import sys
 import tempfile
@@ -26,25 +26,8 @@ COLD_START_TARGET = 30.0
 
 def demo_pipeline() -> Path | None:
     """The README's demo pipeline (``pipelines/demo.toml`` of a source checkout), or None."""
-    path = Path(__file__).resolve().parents[1] / "pipelines" / "demo.toml"
+    path = Path(__file__).resolve().parents[2] / "pipelines" / "demo.toml"
     return path if path.is_file() else None
-
-
-def _child_main(argv):
-    """Entry point of the child process: ``result.json`` then the command line's arguments."""
-    compiled = {}
-
-    def done(what, seconds):
-        compiled[what] = compiled.get(what, 0.0) + seconds
-
-    from shipblock.cli import compile_notice, main
-
-    with compile_notice(lambda message: None, done):
-        code = main(["-q", *argv[1:]])
-    usage = resource.getrusage(resource.RUSAGE_SELF)
-    Path(argv[0]).write_text(json.dumps({"code": code, "compiled": compiled,
-                                         "cpu": usage.ru_utime + usage.ru_stime}))
-    return code
 
 
 def run_command(args, cache_dir, work_dir):
@@ -58,11 +41,13 @@ def run_command(args, cache_dir, work_dir):
     """
     result = Path(work_dir) / "cold-start-result.json"
     env = {**os.environ, "NUMBA_CACHE_DIR": str(cache_dir)}
-    package_root = str(Path(__file__).resolve().parents[1])
+    package_root = str(Path(__file__).resolve().parents[2])
     env["PYTHONPATH"] = os.pathsep.join(p for p in (package_root, env.get("PYTHONPATH")) if p)
+    # The command line as its entry point runs it, with its report of what numba compiled
+    # (``--compile-report``, written by the child: :func:`shipblock.cli.main`).
     cmd = [sys.executable, "-c",
-           "import sys; from shipblock.bench_startup import _child_main; "
-           "sys.exit(_child_main(sys.argv[1:]))", str(result), *map(str, args)]
+           "import sys; from shipblock.cli import main; sys.exit(main(sys.argv[1:]))",
+           "-q", "--compile-report", str(result), *map(str, args)]
     t0 = time.perf_counter()
     subprocess.run(cmd, env=env, cwd=work_dir, check=True, stdout=subprocess.DEVNULL,
                    stderr=subprocess.DEVNULL)

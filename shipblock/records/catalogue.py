@@ -4,7 +4,7 @@ Each ``[[record]]`` table of the catalogue names one station's record: its files
 inventory, event (QuakeML), station and site, licence and credit, and the mapping of its channel
 codes to the components H1, H2 and V. Paths are relative to the catalogue file.
 :func:`load_catalogue` parses and validates the file (without reading any waveform); each
-:class:`CatalogueEntry` reads its :class:`~shipblock.motion.GroundMotion` on demand.
+:class:`CatalogueEntry` reads its :class:`~shipblock.records.motion.GroundMotion` on demand.
 """
 
 from __future__ import annotations
@@ -13,9 +13,14 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from shipblock import checks
 from shipblock.errors import ParameterError, ParameterTypeError, RecordError
-from shipblock.motion import COMPONENTS, GroundMotion, read_motion
+from shipblock.records.folders import MotionSet
+from shipblock.records.motion import COMPONENTS, GroundMotion
+from shipblock.records.reading import read_motion
+from shipblock.units import STANDARD_GRAVITY
 
 __all__ = ["CatalogueEntry", "catalogue_toml", "default_catalogue_path", "load_catalogue"]
 
@@ -33,7 +38,7 @@ def default_catalogue_path() -> Path:
     pathlib.Path
         ``<repository>/records/catalogue.toml`` (the records are not part of the wheel).
     """
-    return Path(__file__).resolve().parent.parent / "records" / "catalogue.toml"
+    return Path(__file__).resolve().parents[2] / "records" / "catalogue.toml"
 
 
 @dataclass(frozen=True)
@@ -297,7 +302,7 @@ def _inventory_file(motion, inventories: dict) -> Path | None:
 
 def catalogue_toml(motions, output, licence: str | None = None, credit: str | None = None,
                    units: str | None = None) -> str:
-    """The text of a record catalogue for the records of a :class:`~shipblock.collection.MotionSet`.
+    """The text of a record catalogue for the records of a :class:`~shipblock.records.folders.MotionSet`.
 
     Each record becomes a ``[[record]]`` table that :func:`load_catalogue` reads back: id
     (``NET.STA.LOC.SENSOR``), files and StationXML inventory relative to the catalogue's folder,
@@ -310,7 +315,7 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
     Parameters
     ----------
     motions : MotionSet
-        From :func:`shipblock.collection.read_motions`.
+        From :func:`shipblock.records.folders.read_motions`.
     output : str or os.PathLike
         Where the catalogue will be written (paths in it are relative to its folder).
     licence, credit : str, optional
@@ -330,11 +335,6 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
         MotionSet, ``output`` not a path, ``licence`` or ``credit`` not a string, an unknown
         ``units``.
     """
-    import numpy as np
-
-    from shipblock.collection import MotionSet
-    from shipblock.units import STANDARD_GRAVITY
-
     if not isinstance(motions, MotionSet):
         raise ParameterTypeError(f"motions must be a MotionSet (from read_motions), got "
                                  f"{type(motions).__name__} {motions!r}"[:300])

@@ -3,7 +3,7 @@ non-rocking spans' loads from the range of their input.
 
 :func:`note_loads` raises the summary's peaks (``S_PEAK_FY`` ... ``S_PEAK_CORNER`` of
 :mod:`~shipblock.solver._layout`) with the interface forces at one instant; see
-:mod:`~shipblock.solver._loads` for where the kernel takes them. Without a vertical input the
+:mod:`~shipblock.solver._force_sampling` for where the kernel takes them. Without a vertical input the
 forces of a non-rocking mode are linear in the scaled horizontal input ``a`` alone, so the
 closed-form spans (:mod:`~shipblock.solver._closed_form`) keep only the least and greatest
 ``a`` they pass, at two operations a sample, and :func:`note_span_extremes` notes the loads
@@ -62,7 +62,7 @@ def note_loads(p, rock, fx, fy, Fx, Fy, summary):
 def note_mode_loads(p, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, a, G, summary):
     """:func:`note_loads` of a non-rocking mode at input ``(a, G)``: the forces
     ``a w_a + G w_G`` from the components of its response vectors (as
-    :func:`~shipblock.solver._loads.span_loads` computes them, to the bit)."""
+    :func:`~shipblock.solver._force_sampling.span_loads` computes them, to the bit)."""
     note_loads(p, 0, fx_a * a + fx_g * G, fy_a * a + fy_g * G, Fx_a * a + Fx_g * G,
                Fy_a * a + Fy_g * G, summary)
 
@@ -96,5 +96,5 @@ def folds_loads(has_ay, fy_a, Fy_a):
     """Whether a closed-form span notes the loads of its samples itself (from the range of its
     input, :func:`note_span_extremes`): without a vertical input and with normal forces that
     do not depend on ``a`` (as while the blocks do not rock). Otherwise
-    :func:`~shipblock.solver._loads.span_loads` scans the span's samples afterwards."""
+    :func:`~shipblock.solver._force_sampling.span_loads` scans the span's samples afterwards."""
     return not has_ay and fy_a == 0.0 and Fy_a == 0.0

@@ -3,9 +3,11 @@
 An agency download is a folder (or a glob) of files: one file per component (K-NET, MiniSEED,
 SAC, ESM), three components per file (CSMIP, GeoNet, COSMOS), StationXML inventories and an
 event file beside them. :func:`read_motions` reads every file it can, groups the traces into
-one record per station sensor, converts each with :func:`shipblock.motion.read_motion`, and
-returns the records together with the list of files and groups that could not be used and why.
-One bad file never costs the others.
+one record per station sensor, converts each the way
+:func:`~shipblock.records.reading.read_motion` does
+(:func:`~shipblock.records.assembly.assemble_motion`), and returns the records together with
+the list of files and groups that could not be used and why. One bad file never costs the
+others.
 
 Grouping key of a trace: network, station, location, the first two letters of the channel
 (band and instrument: one sensor; K-NET/KiK-net borehole and surface sensors have locations
@@ -34,7 +36,10 @@ from obspy import Stream
 from shipblock import checks
 from shipblock.errors import ParameterError, RecordError, ShipblockError
 from shipblock.io import read_record
-from shipblock.motion import GroundMotion, check_read_arguments, read_motion, sensor_code
+from shipblock.records.arguments import check_read_arguments
+from shipblock.records.assembly import assemble_motion, load_stream
+from shipblock.records.motion import GroundMotion
+from shipblock.records.sensors import sensor_code
 
 __all__ = ["MotionSet", "expand_sources", "read_motions"]
 
@@ -214,9 +219,9 @@ def read_motions(source, inventory=None, units: str | None = None, *,
     inventory : str, os.PathLike or obspy.Inventory, optional
         StationXML for raw counts. Default: every StationXML file among the sources, merged.
     units : str, optional
-        Unit of records that state none (see :func:`shipblock.motion.read_motion`).
+        Unit of records that state none (see :func:`~shipblock.records.reading.read_motion`).
     response, differentiate, align, gaps
-        As in :func:`shipblock.motion.read_motion`.
+        As in :func:`~shipblock.records.reading.read_motion`.
     event : optional
         QuakeML file or object; default: a QuakeML file among the sources, if there is one.
 
@@ -229,7 +234,8 @@ def read_motions(source, inventory=None, units: str | None = None, *,
     ------
     ParameterError
         Before any file is read, if an argument is of the wrong type or value, naming it (as
-        :func:`shipblock.motion.read_motion`: ``units="furlongs"``, ``response="partial"``...);
+        :func:`~shipblock.records.reading.read_motion`: ``units="furlongs"``,
+        ``response="partial"``...);
         a wrong option is not a failure of every record.
     RecordError
         If the source names nothing, or an inventory or event path names no file; a folder in
@@ -282,9 +288,10 @@ def read_motions(source, inventory=None, units: str | None = None, *,
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                motion = read_motion(
-                    stream, inventory=inventory, units=units, response=response,
-                    differentiate=differentiate, align=align, gaps=gaps, event=event,
+                motion = assemble_motion(
+                    load_stream(stream, units, None, {}), inventory=inventory, units=units,
+                    response=response, differentiate=differentiate, align=align, gaps=gaps,
+                    event=event,
                 )
         except ShipblockError as exc:
             files = ", ".join(dict.fromkeys(str(tr.stats.get("source_file", "")) for tr in stream))

@@ -1,6 +1,6 @@
 """Benchmarks of parallel work: a batch beside a busy core, and Dask clusters of 1 and 2 workers.
 
-Part of ``shipblock bench`` (:func:`shipblock.bench.run_benchmarks`).
+Part of ``shipblock bench`` (:func:`shipblock.bench.run.run_benchmarks`).
 
 * :func:`busy_core_batch`: :func:`~shipblock.simulate_batch` on one thread and on all, on the
   machine as it is and with a competing busy process (issue 21: with one core held busy, a
@@ -19,6 +19,10 @@ import time
 
 import numpy as np
 
+from shipblock.bench.campaign import write_campaign_pipeline
+from shipblock.bench.timing import benchmark_records, interleaved_times, sliding_system
+from shipblock.solver import RecordSet, simulate_batch
+from shipblock.solver._threads import batch_threads
 from shipblock.units import STANDARD_GRAVITY
 
 #: Scale factors per record in :func:`busy_core_batch` (18 pySLAMMER records: 360 cases).
@@ -56,7 +60,7 @@ def busy_core_batch(min_seconds=3.0, copies=(1, 10)):
     :class:`~shipblock.RecordSet`; without pySLAMMER the bench's six shipped records at 60
     factors). Each entry of ``copies`` repeats the cases that many times (10: a batch ten times
     as long). In every round the batch runs on one thread and on all
-    (:func:`shipblock.bench.interleaved_times`) for ``min_seconds``, first on the machine as it
+    (:func:`shipblock.bench.timing.interleaved_times`) for ``min_seconds``, first on the machine as it
     is, then with :func:`busy_process` running.
 
     Returns
@@ -69,13 +73,9 @@ def busy_core_batch(min_seconds=3.0, copies=(1, 10)):
     """
     import numba
 
-    from shipblock.bench import _records, interleaved_times, sliding_system
-    from shipblock.solver import RecordSet, simulate_batch
-    from shipblock.solver._threads import batch_threads
-
     loaded = _busy_records()
     if loaded is None:
-        recs, dts = zip(*[((h, None), dt) for _, h, _, dt in _records()], strict=True)
+        recs, dts = zip(*[((h, None), dt) for _, h, _, dt in benchmark_records()], strict=True)
         scales = np.linspace(0.5, 1.45, 3 * BUSY_SCALES)
     else:
         recs, dts = loaded
@@ -144,8 +144,6 @@ def _warm_worker():
     """Load the compiled solver in a worker process (from numba's cache, compiling if empty)
     and import what a chunk task and a bootstrap block import, as a long campaign would have."""
     import shipblock.fragility.pipeline  # noqa: F401  (batch, fit, workers, xarray)
-    from shipblock.bench import sliding_system
-    from shipblock.solver import simulate_batch
 
     simulate_batch(sliding_system(), [(np.zeros(64), None)], [0.01], [[0, 0, 1.0, 1.0]])
     return True
@@ -165,7 +163,7 @@ def dask_scaling(n_workers=(1, 2), quick=False, directory=None):
     """Pipelines here and on Dask LocalClusters of ``n_workers`` one-core worker processes.
 
     Two pipelines (:data:`DASK_CASES`), both the bench's campaign pipeline
-    (:func:`shipblock.bench.write_campaign_pipeline`: the six shipped records, IDA levels, a
+    (:func:`shipblock.bench.campaign.write_campaign_pipeline`: the six shipped records, IDA levels, a
     friction x slenderness sweep): "runs", 30,000 runs without bootstrap, for the solver's part;
     "fits", 3,000 runs with 500 bootstrap resamples per fit, for the fits. Each runs once here
     (the batch on all cores, the bootstrap here or on local processes), then on each cluster:
@@ -191,8 +189,6 @@ def dask_scaling(n_workers=(1, 2), quick=False, directory=None):
         import distributed
     except ImportError:
         return None
-    from shipblock.bench import write_campaign_pipeline
-
     cases = QUICK_DASK_CASES if quick else DASK_CASES
     out = {}
     with tempfile.TemporaryDirectory(prefix="shipblock-dask-") as tmp:

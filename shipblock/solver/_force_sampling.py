@@ -1,7 +1,7 @@
 """Peak contact loads of a run: the interface forces' running peaks in the summary (compiled).
 
 The kernel hands every set of interface forces it has at hand to :func:`note_loads` (of
-:mod:`~shipblock.solver._load_peaks`, imported here): the forces
+:mod:`~shipblock.solver._running_peaks`, imported here): the forces
 ``(fx, fy)`` of the ground on the blocks and ``(Fx, Fy)`` of the blocks on the ship, totals over
 the ``n`` blocks [N]. It keeps the peaks of ``fy``, ``|fx|``, ``Fy``, ``|Fx|``, of the friction
 utilisations ``|fx| / (mu_s1 fy)`` and ``|Fx| / (mu_s2 Fy)`` and, while the blocks rock, of
@@ -14,7 +14,7 @@ Where the forces come from decides the accuracy:
   response vectors, linear in time between samples, and the utilisations ratios of such linear
   functions (monotone between samples), so the peaks over a span are at its samples and ends:
   exact. Without a vertical input the closed-form span notes its samples itself, in its own
-  scan for the next event (:mod:`~shipblock.solver._load_peaks`);
+  scan for the next event (:mod:`~shipblock.solver._running_peaks`);
 * rocking: the forces at the end of every accepted step (the steps' own last stage, at most one
   sample long) and on both sides of every event (:func:`state_loads`). Between step ends the
   forces vary smoothly and their peak can be missed by about ``h^2 |f''| / 8``
@@ -45,7 +45,7 @@ from shipblock.solver._layout import (
     Y_OM,
     Y_TH,
 )
-from shipblock.solver._load_peaks import (
+from shipblock.solver._running_peaks import (
     folds_loads,
     note_loads,
 )
@@ -122,7 +122,7 @@ def span_loads(p, ms, work, ax, ay, has_ay, sh, sv, dt, k0, tau0, k1, tau1, summ
     utilisation ``|fx_a (a/G) + fx_G| / (mu fy_G)`` that of the greatest or least ``a/G``.
     Without a vertical input ``G = g`` and the span notes its loads itself, ends included,
     from the least and greatest ``a`` it passed
-    (:func:`~shipblock.solver._load_peaks.note_span_extremes`), and nothing is done here. (A
+    (:func:`~shipblock.solver._running_peaks.note_span_extremes`), and nothing is done here. (A
     mode whose normal forces did depend on ``a`` would be scanned sample by sample.)
     """
     start = mode_response_start(p, work, ms[MS_SLIP1], float(ms[MS_SIG1]), ms[MS_SLIP2],

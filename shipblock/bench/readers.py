@@ -4,7 +4,7 @@ Behind ``shipblock bench --read SOURCE ...``. Every file of the sources is read 
 format (files that cannot be read are counted, not timed); then, per format, the files of that
 format are read again and again (:func:`shipblock.io.read_record`) for at least ``min_seconds``,
 and the whole set is read and converted into ground motions by
-:func:`shipblock.collection.read_motions` (grouping, unit conversion, alignment). Measured, never
+:func:`shipblock.records.folders.read_motions` (grouping, unit conversion, alignment). Measured, never
 asserted in unit tests.
 """
 
@@ -14,7 +14,7 @@ import time
 import warnings
 from collections import defaultdict
 
-from shipblock.collection import NOT_WAVEFORMS, expand_sources, read_motions
+from shipblock.records.folders import NOT_WAVEFORMS, expand_sources, read_motions
 from shipblock.errors import ShipblockError
 from shipblock.io import read_record
 
