@@ -46,6 +46,8 @@ GRAVITY_NOTE_THRESHOLD = 0.5 * STANDARD_GRAVITY
 
 
 def load_stream(paths_or_stream, units, fmt, read_kwargs) -> Stream:
+    """The traces of record files (read with :func:`~shipblock.io.read_record`), or a copy of
+    a Stream or Trace, each trace tagged with its ``stats.source_file``."""
     if isinstance(paths_or_stream, Stream):
         stream = paths_or_stream.copy()
         for trace in stream:
@@ -62,6 +64,7 @@ def load_stream(paths_or_stream, units, fmt, read_kwargs) -> Stream:
 
 
 def load_inventory(inventory):
+    """``(obspy.Inventory or None, its name for messages)`` of a StationXML file or object."""
     if inventory is None or isinstance(inventory, obspy.Inventory):
         return inventory, ("<inventory>" if inventory is not None else None)
     name = os.fspath(inventory)  # an existing file: check_read_arguments
@@ -115,10 +118,11 @@ def assemble_motion(stream: Stream, *, inventory=None, units: str | None = None,
     ----------
     stream : obspy.Stream
         The record's traces, as :func:`load_stream` gives them (changed in place).
-    inventory, units, response, differentiate, align, gaps, event, azimuth, horizontal, \
-channel_map, sensor
+    inventory, units, response, differentiate, align, gaps, event
         As in :func:`~shipblock.records.reading.read_motion`, already checked
         (:func:`~shipblock.records.arguments.check_read_arguments`).
+    azimuth, horizontal, channel_map, sensor
+        As in :func:`~shipblock.records.reading.read_motion`, already checked.
 
     Returns
     -------

@@ -90,10 +90,12 @@ def rotate_to_azimuth(h1, h2, azimuth_h1: float, azimuth_h2: float, azimuth: flo
 
 
 def trace_source(trace: Trace) -> str:
+    """The file a trace was read from, for messages (``"<stream>"`` for traces in memory)."""
     return str(trace.stats.get("source_file", "<stream>"))
 
 
 def check_finite(trace: Trace) -> None:
+    """Refuse a trace without samples or with NaN/inf samples (RecordError naming the file)."""
     name = trace_source(trace)
     if trace.stats.npts == 0 or len(trace.data) == 0:
         raise RecordError(name, f"channel {trace.id} has no samples (zero-length trace)")

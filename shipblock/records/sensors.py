@@ -26,6 +26,7 @@ _TWO_LETTER = {"NS": "N", "EW": "E", "UD": "Z"}
 
 
 def orientation_letter(channel: str) -> str:
+    """The orientation letter of a channel code (``"HNZ"`` -> ``"Z"``, ``"UD"`` -> ``"Z"``)."""
     code = channel.strip().upper()
     if code in _TWO_LETTER:
         return _TWO_LETTER[code]

@@ -1,4 +1,5 @@
-"""Peak contact loads of a run: the interface forces' running peaks in the summary (compiled).
+"""Where the kernel takes the contact loads: the interface forces over a span, and at a state
+(compiled), handed to the running peaks of the summary.
 
 The kernel hands every set of interface forces it has at hand to :func:`note_loads` (of
 :mod:`~shipblock.solver._running_peaks`, imported here): the forces
