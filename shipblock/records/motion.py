@@ -89,6 +89,19 @@ def rotate_to_azimuth(h1, h2, azimuth_h1: float, azimuth_h2: float, azimuth: flo
     )
 
 
+def check_direction(azimuth, horizontal) -> float | None:
+    """``azimuth`` checked (a number within +-360 deg, or None), ``horizontal`` one of H1/H2 or
+    None, not both given; returns the azimuth [deg]."""
+    if azimuth is not None:
+        azimuth = checks.azimuth(azimuth, "azimuth")
+    if horizontal is not None:
+        checks.choice(horizontal, "horizontal", ("H1", "H2"))
+    if azimuth is not None and horizontal is not None:
+        raise ParameterError("azimuth and horizontal exclude each other: give azimuth= or"
+                             " horizontal=, not both")
+    return azimuth
+
+
 def trace_source(trace: Trace) -> str:
     """The file a trace was read from, for messages (``"<stream>"`` for traces in memory)."""
     return str(trace.stats.get("source_file", "<stream>"))
@@ -194,13 +207,7 @@ class GroundMotion:
         if not (metadata is None or isinstance(metadata, Mapping)):
             raise ParameterTypeError(f"metadata must be a dict or None, got "
                                      f"{type(metadata).__name__} {metadata!r}"[:300])
-        if azimuth is not None:
-            azimuth = checks.azimuth(azimuth, "azimuth")
-        if horizontal is not None:
-            checks.choice(horizontal, "horizontal", ("H1", "H2"))
-        if azimuth is not None and horizontal is not None:
-            raise ParameterError("azimuth and horizontal exclude each other: give azimuth= or"
-                                 " horizontal=, not both")
+        azimuth = check_direction(azimuth, horizontal)
         self._metadata = dict(metadata or {})
         files = self._metadata.get("source_files") or []
         label = (", ".join(str(f) for f in files) if isinstance(files, list | tuple)

@@ -35,7 +35,7 @@ from shipblock.errors import ParameterError, ParameterTypeError, RecordError
 from shipblock.records.arguments import check_channel_map, check_read_arguments
 from shipblock.records.assembly import assemble_motion, load_stream
 from shipblock.records.folders import read_motions
-from shipblock.records.motion import GroundMotion
+from shipblock.records.motion import GroundMotion, check_direction
 from shipblock.records.sensors import select_sensor
 
 __all__ = ["read_motion"]
@@ -205,13 +205,7 @@ def read_motion(
                                    event=event, format=format)
     inventory, event, format = options["inventory"], options["event"], options["format"]
     differentiate = options["differentiate"]
-    if azimuth is not None:
-        azimuth = checks.azimuth(azimuth, "azimuth")
-    if horizontal is not None:
-        checks.choice(horizontal, "horizontal", ("H1", "H2"))
-    if azimuth is not None and horizontal is not None:
-        raise ParameterError("azimuth and horizontal exclude each other: give azimuth= or"
-                             " horizontal=, not both")
+    azimuth = check_direction(azimuth, horizontal)
     channel_map = check_channel_map(channel_map)
     sensor = checks.text(sensor, "sensor", optional=True,
                          what="a sensor code such as 'HN' or '02.HN'")
