@@ -549,6 +549,23 @@ def cmd_plot(args):
     return 0
 
 
+def cmd_risk(args):
+    from shipblock.risk.study import risk_lines, run_risk
+
+    ds = run_risk(args.results, args.hazard, args.days, output=args.output, site=args.site,
+                  format=args.format, measure=args.measure, band=not args.no_band)
+    out = sys.stdout
+    out.write(f"risk written to {ds.encoding['source']}\n")
+    for line in risk_lines(ds):
+        out.write(line + "\n")
+    if args.figure:
+        from shipblock.plot_risk import plot_risk
+
+        _save_figure(lambda: plot_risk(ds)[0].figure, args.figure)
+        out.write(f"figure written to {args.figure}\n")
+    return 0
+
+
 def cmd_bench(args):
     if args.read:
         import json
@@ -670,6 +687,28 @@ def build_parser():
                    help="with --kind median: the swept parameter on the x axis (default: the "
                         "first)")
     s.set_defaults(func=cmd_plot)
+
+    s = sub.add_parser("risk", help="risk over a docking period: fragility x site hazard",
+                       description="Convolve every fitted fragility of a result with a site "
+                       "hazard curve: annual rate of exceedance, return period, probability "
+                       "during the docking period (Poisson), bootstrap band and deaggregation "
+                       "over the intensity; written to a copy of the result.")
+    s.add_argument("results", help="NetCDF written by 'shipblock run'")
+    s.add_argument("--hazard", required=True, metavar="FILE",
+                   help="hazard curve: OpenQuake hazard_curve CSV, USGS nshmp-haz CSV, USGS "
+                        "hazard service JSON, or a two-column table with units in its header")
+    s.add_argument("--days", required=True, type=float, help="docking period [d]")
+    s.add_argument("--site", help="site of a file with several: its name or LON,LAT [deg]")
+    s.add_argument("--format", default="auto",
+                   choices=["auto", "openquake", "nshmp-csv", "usgs-json", "table"],
+                   help="layout of the hazard file (default: told from the file)")
+    s.add_argument("--measure", help="IMT of the hazard file when it does not say (e.g. PGA, "
+                                     "SA1P0)")
+    s.add_argument("--output", "-o", help="NetCDF to write (default: <results>_risk.nc)")
+    s.add_argument("--figure", help="PNG of the hazard, fragilities and deaggregation")
+    s.add_argument("--no-band", action="store_true",
+                   help="skip the bootstrap band (the replicates are made again)")
+    s.set_defaults(func=cmd_risk)
 
     s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "
                                      "batch scaling")
