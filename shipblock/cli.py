@@ -566,6 +566,40 @@ def cmd_risk(args):
     return 0
 
 
+def cmd_select(args):
+    from shipblock.catalogue import load_catalogue
+    from shipblock.risk.selection import (
+        select_records,
+        selection_lines,
+        selection_toml,
+        target_from_file,
+    )
+
+    entries = load_catalogue(args.catalogue)
+    target = target_from_file(args.target, args.units)
+    vertical = (None if args.vertical_target is None
+                else target_from_file(args.vertical_target, args.vertical_units or args.units))
+    selection = select_records(
+        entries, target, args.k, period_range=args.period_range, vertical_target=vertical,
+        vertical_weight=args.vertical_weight, scale=not args.no_scale,
+        min_scale_factor=args.min_scale_factor, max_scale_factor=args.max_scale_factor,
+        horizontal=args.horizontal, processing=[] if args.no_processing else None)
+    output = Path(args.output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    partial = output.with_name(output.name + ".part")
+    partial.write_text(selection_toml(selection, entries, output))
+    try:
+        load_catalogue(partial)  # what is written reads back
+    except Exception:
+        partial.unlink()
+        raise
+    partial.replace(output)
+    sys.stdout.write(f"selection written to {output}\n")
+    for line in selection_lines(selection):
+        sys.stdout.write(line + "\n")
+    return 0
+
+
 def cmd_bench(args):
     if args.read:
         import json
@@ -709,6 +743,36 @@ def build_parser():
     s.add_argument("--no-band", action="store_true",
                    help="skip the bootstrap band (the replicates are made again)")
     s.set_defaults(func=cmd_risk)
+
+    s = sub.add_parser("select", help="choose the records of a catalogue that best match a "
+                                      "target spectrum",
+                       description="Rank the records of a catalogue by the misfit of their "
+                       "spectra (horizontal, and vertical with --vertical-target) to a target "
+                       "over a period range, each scaled by its best factor within bounds; "
+                       "write the best k as a catalogue a pipeline reads, with the ASCE 7-16 "
+                       "suite-mean check.")
+    s.add_argument("catalogue", help="catalogue TOML (e.g. from 'shipblock catalogue')")
+    s.add_argument("--target", required=True, metavar="FILE",
+                   help="target spectrum: two columns, period [s] and Sa (uniform hazard or "
+                        "conditional mean); the Sa unit from --units or the header, e.g. "
+                        "'period [s], Sa [g]'")
+    s.add_argument("--units", help="unit of the target's Sa (g, m/s^2, ...)")
+    s.add_argument("-k", type=int, default=7, help="number of records to choose (default 7)")
+    s.add_argument("--output", "-o", default="selected.toml", help="catalogue TOML to write")
+    s.add_argument("--period-range", nargs=2, type=float, metavar=("TA", "TB"),
+                   help="periods compared [s] (default: the target's range)")
+    s.add_argument("--vertical-target", metavar="FILE", help="target spectrum of the vertical")
+    s.add_argument("--vertical-units", help="unit of its Sa (default --units or its header)")
+    s.add_argument("--vertical-weight", type=float, default=1.0,
+                   help="weight of the vertical misfit (default 1)")
+    s.add_argument("--horizontal", default="H1", choices=["H1", "H2", "geomean"],
+                   help="horizontal spectrum compared (default H1, as a pipeline's default)")
+    s.add_argument("--no-scale", action="store_true", help="compare the records unscaled")
+    s.add_argument("--min-scale-factor", type=float, default=0.25, help="default 0.25")
+    s.add_argument("--max-scale-factor", type=float, default=4.0, help="default 4")
+    s.add_argument("--no-processing", action="store_true",
+                   help="spectra of the records as read (default: the default processing chain)")
+    s.set_defaults(func=cmd_select)
 
     s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "
                                      "batch scaling")

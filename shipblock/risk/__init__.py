@@ -20,6 +20,13 @@ from shipblock.risk.integral import (
     period_probability,
     risk_integral,
 )
+from shipblock.risk.selection import (
+    RecordMatch,
+    Selection,
+    select_records,
+    selection_toml,
+    target_from_file,
+)
 from shipblock.risk.study import bootstrap_replicates, risk_dataset, run_risk, study_measure
 
 __all__ = [
@@ -27,12 +34,17 @@ __all__ = [
     "HAZARD_FORMATS",
     "HazardCurve",
     "HazardError",
+    "RecordMatch",
     "RiskIntegral",
+    "Selection",
     "bootstrap_replicates",
     "period_probability",
     "read_hazard_curve",
     "risk_dataset",
     "risk_integral",
     "run_risk",
+    "select_records",
+    "selection_toml",
     "study_measure",
+    "target_from_file",
 ]
