@@ -227,6 +227,32 @@ def test_usgs_service_json_reads_the_total_curve(tmp_path):
     assert read_hazard_curve(path, measure="SA(1.0)").period == 1.0
 
 
+def test_usgs_nshmp_haz_2_service_json_reads_the_total_curve(tmp_path):
+    # the layout of nshmp-haz 2's HazardService: response.hazardCurves[].data[].values.xs/ys,
+    # the site in the request, here cut at 1e-4 ("truncate") as the service can
+    levels, lam = nshmp_rows(PGA_CURVES)["Seattle WA"]
+    keep = lam > 1e-4
+    doc = {"name": "Hazard Service", "status": "success",
+           "request": {"longitude": -122.3, "latitude": 47.6, "vs30": 760.0, "truncate": True,
+                       "maxdir": False},
+           "response": {"metadata": {"xlabel": "Ground Motion (g)",
+                                     "ylabel": "Annual Frequency of Exceedance"},
+                        "hazardCurves": [{"imt": {"display": "PGA", "value": "PGA"}, "data": [
+                            {"component": "Total", "values": {"xs": list(levels[keep]),
+                                                              "ys": list(lam[keep])}},
+                            {"component": "Interface", "values": {"xs": list(levels[keep]),
+                                                                  "ys": list(lam[keep] / 3)}}]}]}}
+    path = tmp_path / "hazard2.json"
+    path.write_text(json.dumps(doc))
+    curve = read_hazard_curve(path, site="-122.3,47.6")
+    np.testing.assert_array_equal(curve.rate, lam[keep])
+    np.testing.assert_allclose(curve.im, levels[keep] * G)
+    assert curve.provenance["truncate"] is True and curve.provenance["maxdir"] is False
+    assert curve.provenance["vs30"] == 760.0
+    with pytest.raises(HazardError, match="site 'Bremerton' is not in the file"):
+        read_hazard_curve(path, site="Bremerton")
+
+
 def test_two_column_tables_need_units_in_the_header(tmp_path):
     path = tmp_path / "curve.csv"
     path.write_text("# site: test\nPGA [m/s^2], annual_rate [1/yr]\n0.5, 1e-2\n2.0, 1e-3\n"

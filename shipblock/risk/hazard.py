@@ -21,11 +21,19 @@ measure it is for and the file's provenance (path, SHA-256, layout, site):
     ``"valueFormat": "POISSON_PROBABILITY"``, which is refused (its time span is not stated in
     the file).
 ``usgs-json``
-    The JSON of the USGS hazard web service behind the Unified Hazard Tool (nshmp-haz-ws
-    ``/hazard``): ``{"response": [{"metadata": {"imt": {"value": "PGA"}, "xlabel": "Ground
-    Motion (g)", "ylabel": "Annual Frequency of Exceedence", "xvalues": [...], "longitude",
-    "latitude", "vs30", ...}, "data": [{"component": "Total", "yvalues": [...]}, ...]}, ...]}``,
-    one response per IMT; the ``Total`` component is used.
+    The JSON of the USGS hazard web services behind the Unified Hazard Tool, in either
+    generation: nshmp-haz-ws ``/hazard`` (``{"response": [{"metadata": {"imt": {"value":
+    "PGA"}, "xlabel": "Ground Motion (g)", "ylabel": "Annual Frequency of Exceedence",
+    "xvalues": [...], "longitude", "latitude", "vs30", ...}, "data": [{"component": "Total",
+    "yvalues": [...]}, ...]}, ...]}``, one response per IMT) or nshmp-haz 2's hazard service
+    (``{"request": {"longitude", "latitude", "vs30", "truncate", "maxdir"}, "response":
+    {"metadata": {"xlabel", "ylabel"}, "hazardCurves": [{"imt": {"value": "PGA"}, "data":
+    [{"component": "Total", "values": {"xs": [...], "ys": [...]}}]}]}}``); the ``Total``
+    component is used. The layouts are those of the services' source code (``HazardService``
+    of nshmp-haz-ws and of nshmp-haz 2). ``maxdir`` (levels scaled to the maximum direction)
+    and ``truncate`` (the curve cut where its rate falls below 1e-4) are kept in the
+    provenance: a curve cut at 1e-4 leaves the rarer levels to the extended end slope
+    (see ``risk_tail_fraction``).
 ``table``
     Two columns with units in the header, e.g. ``PGA [g], annual_rate [1/yr]`` or
     ``Sa(1.0) [m/s^2], poe_50yr [-]`` (probability of exceedance in 50 years); comma,
@@ -302,24 +310,66 @@ def _read_nshmp(text, source, site, measure_hint):
     return (levels, rate, measure, period, _AGENCY_UNITS[measure], provenance)
 
 
+def _imt_name(imt) -> str | None:
+    """The IMT of a service's ``imt`` entry: ``{"value": "PGA", ...}`` or a plain string."""
+    name = imt.get("value") if isinstance(imt, dict) else imt
+    return None if name is None else str(name)
+
+
+def _usgs_curves(doc, source) -> tuple[dict, dict, dict]:
+    """IMT -> (levels, rates, units) of a USGS hazard service response, its site and labels.
+
+    Two generations of the service: nshmp-haz-ws (``response`` a list, one entry per IMT with
+    ``metadata.xvalues`` and ``data[].yvalues``) and nshmp-haz 2 (``response.hazardCurves``,
+    one entry per IMT with ``data[].values.xs``/``ys``; site and Vs30 in ``request``).
+    """
+    response = doc.get("response") if isinstance(doc, dict) else None
+    curves, site, labels = {}, {}, {}
+    if isinstance(response, dict) and "hazardCurves" in response:
+        meta = response.get("metadata", {}) or {}
+        labels = {"xlabel": meta.get("xlabel", ""), "ylabel": meta.get("ylabel", "")}
+        request = doc.get("request", {}) or {}
+        site = {k: request.get(k) for k in ("longitude", "latitude", "vs30", "maxdir",
+                                            "truncate") if k in request}
+        for entry in response["hazardCurves"]:
+            name = _imt_name(entry.get("imt"))
+            total = [c for c in entry.get("data", [])
+                     if str(c.get("component", "")).lower() == "total"]
+            if name and total:
+                values = total[0]["values"]
+                curves[name] = (values["xs"], values["ys"])
+        return curves, site, labels
+    if isinstance(response, dict):
+        response = [response]
+    if not isinstance(response, list):
+        raise HazardError(source, "not a USGS hazard service response (no 'response' list or "
+                                  "'response.hazardCurves')")
+    for entry in response:
+        meta = entry.get("metadata", {}) or {}
+        name = _imt_name(meta.get("imt"))
+        total = [c for c in entry.get("data", [])
+                 if str(c.get("component", "")).lower() == "total"]
+        if name and total:
+            curves[name] = (meta["xvalues"], total[0]["yvalues"])
+            labels = {"xlabel": meta.get("xlabel", ""), "ylabel": meta.get("ylabel", "")}
+            site = {"longitude": meta.get("longitude"), "latitude": meta.get("latitude")}
+            for key in ("edition", "region", "vs30"):
+                value = meta.get(key)
+                if isinstance(value, dict):
+                    value = value.get("display") or value.get("value")
+                if value is not None:
+                    site[key] = value
+    return curves, site, labels
+
+
 def _read_usgs_json(text, source, site, measure_hint):
     try:
         doc = json.loads(text)
-        responses = doc["response"]
-    except (ValueError, KeyError, TypeError):
-        raise HazardError(source, "not a USGS hazard service response (no 'response' list)") \
-            from None
-    if isinstance(responses, dict):
-        responses = [responses]
-    found = {}
-    for r in responses:
-        meta = r.get("metadata", {})
-        imt = meta.get("imt", {})
-        name = imt.get("value") if isinstance(imt, dict) else imt
-        if name:
-            found[str(name)] = r
+    except ValueError:
+        raise HazardError(source, "is not JSON") from None
+    found, where, labels = _usgs_curves(doc, source)
     if not found:
-        raise HazardError(source, "no response names its imt (metadata.imt.value)")
+        raise HazardError(source, "holds no curve with an imt and a 'Total' component")
     if measure_hint is None:
         if len(found) > 1:
             raise HazardError(source, f"holds curves for {', '.join(found)}: choose one with "
@@ -332,29 +382,21 @@ def _read_usgs_json(text, source, site, measure_hint):
             raise HazardError(source, f"holds no curve for {measure_hint}; it has "
                                       f"{', '.join(found)}")
         name = names[0]
-    r = found[name]
-    meta = r["metadata"]
+    levels, rates = found[name]
     measure, period = parse_measure(name, source)
-    xlabel = str(meta.get("xlabel", ""))
-    unit = re.search(r"\(([^)]+)\)", xlabel)
+    unit = re.search(r"\(([^)]+)\)", str(labels.get("xlabel", "")))
     unit = unit.group(1) if unit else _AGENCY_UNITS[measure]
-    ylabel = str(meta.get("ylabel", ""))
+    ylabel = str(labels.get("ylabel", ""))
     if ylabel and "annual" not in ylabel.lower():
         raise HazardError(source, f"ylabel {ylabel!r}: only annual rates of exceedance are read")
-    total = [c for c in r.get("data", []) if str(c.get("component", "")).lower() == "total"]
-    if not total:
-        raise HazardError(source, f"the {name} response has no 'Total' component")
-    provenance = {"imt": name, "site": f"({meta.get('longitude')}, {meta.get('latitude')})"}
-    for key in ("edition", "region", "vs30"):
-        value = meta.get(key)
-        if isinstance(value, dict):
-            value = value.get("display") or value.get("value")
-        if value is not None:
-            provenance[key] = str(value)
+    lon, lat = where.get("longitude"), where.get("latitude")
+    provenance = {"imt": name, "site": f"({lon}, {lat})"}
+    provenance.update({k: (v if isinstance(v, bool | int | float) else str(v))
+                       for k, v in where.items() if k not in ("longitude", "latitude")})
     if site is not None:
-        _select_site([("", float(meta.get("longitude", math.nan)),
-                       float(meta.get("latitude", math.nan)))], site, source)
-    return (meta["xvalues"], total[0]["yvalues"], measure, period, unit, provenance)
+        _select_site([("", float(lon if lon is not None else math.nan),
+                       float(lat if lat is not None else math.nan))], site, source)
+    return (levels, rates, measure, period, unit, provenance)
 
 
 _TABLE_HEADER = re.compile(r"^\s*([^\[\]]+?)\s*\[([^\]]+)\]\s*$")
