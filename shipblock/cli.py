@@ -1,4 +1,4 @@
-"""The ``shipblock`` command: simulate, process, info, run, history, plot, bench.
+"""The ``shipblock`` command: simulate, process, info, catalogue, run, history, plot, risk, select, bench.
 
 The command only parses arguments, calls the library and prints; every computation lives in the
 library. User errors print one line ``shipblock: error: ...`` and exit with status 2.
@@ -556,7 +556,7 @@ def cmd_risk(args):
                   format=args.format, measure=args.measure, band=not args.no_band)
     out = sys.stdout
     out.write(f"risk written to {ds.encoding['source']}\n")
-    for line in risk_lines(ds):
+    for line in risk_lines(ds, args.target_probability):
         out.write(line + "\n")
     if args.figure:
         from shipblock.plot_risk import plot_risk
@@ -583,7 +583,8 @@ def cmd_select(args):
         entries, target, args.k, period_range=args.period_range, vertical_target=vertical,
         vertical_weight=args.vertical_weight, scale=not args.no_scale,
         min_scale_factor=args.min_scale_factor, max_scale_factor=args.max_scale_factor,
-        horizontal=args.horizontal, processing=[] if args.no_processing else None)
+        horizontal=args.horizontal, azimuth=args.azimuth,
+        processing=[] if args.no_processing else None)
     output = Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     partial = output.with_name(output.name + ".part")
@@ -742,6 +743,9 @@ def build_parser():
     s.add_argument("--figure", help="PNG of the hazard, fragilities and deaggregation")
     s.add_argument("--no-band", action="store_true",
                    help="skip the bootstrap band (the replicates are made again)")
+    s.add_argument("--target-probability", type=float, metavar="P",
+                   help="acceptable probability during the docking period: each fit (its upper "
+                        "bound) is marked below or above it")
     s.set_defaults(func=cmd_risk)
 
     s = sub.add_parser("select", help="choose the records of a catalogue that best match a "
@@ -767,6 +771,9 @@ def build_parser():
                    help="weight of the vertical misfit (default 1)")
     s.add_argument("--horizontal", default="H1", choices=["H1", "H2", "geomean"],
                    help="horizontal spectrum compared (default H1, as a pipeline's default)")
+    s.add_argument("--azimuth", type=float,
+                   help="dock transverse axis [deg from north]: horizontals rotated onto it "
+                        "(instead of --horizontal)")
     s.add_argument("--no-scale", action="store_true", help="compare the records unscaled")
     s.add_argument("--min-scale-factor", type=float, default=0.25, help="default 0.25")
     s.add_argument("--max-scale-factor", type=float, default=4.0, help="default 4")

@@ -27,6 +27,7 @@ from shipblock.risk import (
     risk_integral,
     run_risk,
 )
+from shipblock.risk.study import risk_lines
 from shipblock.units import STANDARD_GRAVITY as G
 
 from .test_pipeline import write_pipeline
@@ -363,8 +364,16 @@ def test_command_line_prints_writes_and_draws(study, tmp_path, capsys):
     target = tmp_path / "r.nc"
     figure = tmp_path / "r.png"
     assert main(["-q", "risk", results, "--hazard", str(PGA_CURVES), "--days", "120",
-                 "--site", "Seattle WA", "-o", str(target), "--figure", str(figure)]) == 0
+                 "--site", "Seattle WA", "-o", str(target), "--figure", str(figure),
+                 "--target-probability", "1e-4"]) == 0
     out = capsys.readouterr().out
+    risk = xr.open_dataset(target)
+    upper = risk["risk_probability_upper"].sel(limit_state="ship_slip", mu_ship=0.35).item()
+    assert upper > 1e-4  # Seattle's hazard at 0.42 g: well above one in ten thousand
+    assert "[upper bound ABOVE the target 0.0001]" in out
+    assert any(line.endswith("[upper bound below the target 0.5]")
+               for line in risk_lines(risk, 0.5))
+    risk.close()
     assert f"risk written to {target}" in out
     assert "hazard: PGA at Seattle WA (nshmp-csv" in out
     assert "mu_ship = 0.3" in out and "P(120 d) = " in out

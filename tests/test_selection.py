@@ -193,3 +193,18 @@ def test_command_line_writes_the_selection(catalogue, tmp_path, capsys):
     target.write_text("period, Sa\n0.1, 1\n2.0, 1\n")
     assert main(["-q", "select", str(catalogue), "--target", str(target), "-o", str(out)]) == 2
     assert "give the unit of Sa (units, --units)" in capsys.readouterr().err
+
+
+def test_azimuth_of_a_north_component_gives_its_spectrum_and_east_its_other():
+    # the shipped South Napa records: HNN at 0 deg, HNE at 90 deg (StationXML); rotated onto
+    # azimuth 0 the horizontal is H1, onto 90 deg it is H2
+    ids = ["south-napa-2014/NP.1765", "south-napa-2014/NP.1743"]
+    target = TargetSpectrum(np.array([0.1, 2.0]), np.array([3.0, 0.5]), "flat")
+    kw = {"ids": ids, "processing": [], "n_periods": 8}
+    for azimuth, horizontal in ((0.0, "H1"), (90.0, "H2")):
+        rotated = select_records(None, target, 2, azimuth=azimuth, **kw)
+        plain = select_records(None, target, 2, horizontal=horizontal, **kw)
+        for a, b in zip(rotated.ranked, plain.ranked, strict=True):
+            assert a.id == b.id
+            np.testing.assert_allclose(a.sa_h, b.sa_h, rtol=1e-9)
+        assert rotated.options["horizontal"] == f"azimuth {azimuth:g} deg"

@@ -188,7 +188,9 @@ def target_from_file(path, units: str | None = None) -> TargetSpectrum:
     return read_target_spectrum(path, units)
 
 
-def _horizontal(motion, horizontal: str, periods, damping):
+def _horizontal(motion, horizontal: str | None, periods, damping):
+    if horizontal is None:  # the motion's own horizontal: rotated to the dock's azimuth
+        return intensity.spectral_acceleration(motion.horizontal, motion.dt, periods, damping)
     comps = motion.components
     if horizontal == "geomean":
         if "H1" not in comps or "H2" not in comps:
@@ -254,15 +256,17 @@ def match_record(record_id, sa_h, sa_v, target_h, target_v, *, vertical_weight=1
 def select_records(catalogue, target, k: int, *, period_range=None, vertical_target=None,
                    vertical_weight: float = 1.0, scale: bool = True,
                    min_scale_factor: float = 0.25, max_scale_factor: float = 4.0,
-                   horizontal: str = "H1", damping: float = intensity.DEFAULT_DAMPING,
+                   horizontal: str = "H1", azimuth: float | None = None,
+                   damping: float = intensity.DEFAULT_DAMPING,
                    n_periods: int = DEFAULT_PERIODS, processing=None, ids=None,
                    suite_floor: bool = True) -> Selection:
     """Choose the ``k`` records of a catalogue that best match a target spectrum.
 
     Parameters
     ----------
-    catalogue : str or os.PathLike or dict
-        A catalogue TOML, or the entries of :func:`shipblock.catalogue.load_catalogue`.
+    catalogue : str or os.PathLike or dict or None
+        A catalogue TOML, or the entries of :func:`shipblock.catalogue.load_catalogue`; None:
+        the shipped catalogue.
     target : TargetSpectrum or str or os.PathLike
         Horizontal target (a file as :func:`target_from_file`, unit in its header).
     k : int
@@ -279,6 +283,9 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
         Bounds of the factor [-] (ASCE-style practice keeps them within about 0.25 to 4).
     horizontal : {"H1", "H2", "geomean"}
         Horizontal spectrum compared (the study's component, or the geometric mean).
+    azimuth : float, optional
+        Dock transverse axis [deg clockwise from north]: the horizontals rotated onto it, as a
+        pipeline's ``records.azimuth`` (replaces ``horizontal``).
     damping : float
         Fraction of critical damping of the spectra [-].
     n_periods : int
@@ -304,6 +311,8 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
     entries = catalogue if isinstance(catalogue, dict) else load_catalogue(catalogue)
     k = checks.whole(k, "k", low=1, high=10_000)
     horizontal = checks.choice(horizontal, "horizontal", HORIZONTALS)
+    if azimuth is not None:
+        azimuth = checks.azimuth(azimuth, "azimuth")
     vertical_weight = checks.real(vertical_weight, "vertical_weight", low=0.0)
     min_scale_factor = checks.real(min_scale_factor, "min_scale_factor", low=0.0, low_open=True)
     max_scale_factor = checks.real(max_scale_factor, "max_scale_factor", low=min_scale_factor)
@@ -335,8 +344,9 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
     for record_id in wanted:
         entry = entries[record_id]
         try:
-            motion = process_motion(entry.read(), processing)
-            sa_h = _horizontal(motion, horizontal, periods, damping)
+            motion = process_motion(entry.read(azimuth=azimuth), processing)
+            sa_h = _horizontal(motion, None if azimuth is not None else horizontal, periods,
+                               damping)
             sa_v = None
             if target_v is not None:
                 if motion.vertical is None:
@@ -374,7 +384,8 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
         mean_v = np.mean([m.factor * m.sa_v for m in chosen], axis=0)
     i_min = int(np.argmin(ratio))
     options = {"k": k, "period_range_s": [ta, tb], "n_periods": n_periods,
-               "horizontal": horizontal, "damping": damping, "scale": scale,
+               "horizontal": horizontal if azimuth is None else f"azimuth {azimuth:g} deg",
+               "damping": damping, "scale": scale,
                "min_scale_factor": min_scale_factor, "max_scale_factor": max_scale_factor,
                "vertical_weight": vertical_weight if target_v is not None else 0.0,
                "target": target.source,

@@ -391,18 +391,25 @@ def _format_rate(ds: xr.Dataset, name: str, index) -> str:
     return f"{value:.3g}{band}"
 
 
-def risk_lines(ds: xr.Dataset) -> list[str]:
+def risk_lines(ds: xr.Dataset, target_probability: float | None = None) -> list[str]:
     """What ``shipblock risk`` prints: the hazard, then one line per fit.
 
     Parameters
     ----------
     ds : xarray.Dataset
         A result of :func:`risk_dataset`.
+    target_probability : float, optional
+        An acceptable probability during the docking period [-]: each line then says whether
+        the fit (its upper bootstrap bound when there is a band) is below it, so that the
+        arrangements of a sweep that meet it stand out.
 
     Returns
     -------
     list of str
     """
+    if target_probability is not None:
+        target_probability = checks.real(target_probability, "target_probability", low=0.0,
+                                         high=1.0, low_open=True, high_open=True)
     days = float(ds.attrs["docking_days"])
     lines = [f"hazard: {ds.attrs['hazard_measure']} at {ds.attrs['hazard_site'] or 'the site'} "
              f"({ds.attrs['hazard_format']}, {Path(ds.attrs['hazard_file']).name}, sha256 "
@@ -426,5 +433,17 @@ def risk_lines(ds: xr.Dataset) -> list[str]:
             f"{_format_rate(ds, 'risk_annual_rate', index)} /yr, return period "
             f"{1.0 / rate:.4g} yr, P({days:g} d) = {_format_rate(ds, 'risk_probability', index)}"
             + (f", {float(ds['risk_tail_fraction'].values[index]):.1%} from beyond the curve"
-               if float(ds["risk_tail_fraction"].values[index]) >= 0.01 else ""))
+               if float(ds["risk_tail_fraction"].values[index]) >= 0.01 else "")
+            + _verdict(ds, index, target_probability))
     return lines
+
+
+def _verdict(ds: xr.Dataset, index, target: float | None) -> str:
+    if target is None:
+        return ""
+    banded = "risk_probability_upper" in ds and np.isfinite(
+        ds["risk_probability_upper"].values[index])
+    value = float(ds["risk_probability_upper" if banded else "risk_probability"].values[index])
+    what = "upper bound" if banded else "estimate"
+    return (f"  [{what} below the target {target:g}]" if value < target
+            else f"  [{what} ABOVE the target {target:g}]")
