@@ -324,6 +324,18 @@ def test_study_risk_equals_the_integral_of_each_fit_with_a_reproduced_band(study
         np.testing.assert_allclose(back["risk_annual_rate"].values, expected, rtol=1e-12)
 
 
+def test_risk_of_a_risk_file_replaces_the_earlier_hazard(study, tmp_path):
+    _, results, _ = study
+    first = run_risk(results, PGA_CURVES, 120, site="Seattle WA", output=tmp_path / "a.nc",
+                     band=False)
+    again = run_risk(tmp_path / "a.nc", PGA_CURVES, 30, site="Los Angeles CA", output="",
+                     band=False)
+    direct = run_risk(results, PGA_CURVES, 30, site="Los Angeles CA", output="", band=False)
+    xr.testing.assert_identical(again.drop_attrs(deep=False), direct.drop_attrs(deep=False))
+    assert again.attrs["hazard_site"] == "Los Angeles CA" and again.attrs["docking_days"] == 30
+    assert first.attrs["hazard_site"] == "Seattle WA"
+
+
 def test_a_band_that_does_not_reproduce_the_stored_bounds_is_left_out(study):
     _, _, ds = study
     curve = read_hazard_curve(PGA_CURVES, site="San Francisco CA")

@@ -260,6 +260,11 @@ def risk_dataset(ds: xr.Dataset, curve: HazardCurve, days: float, *, band: bool 
     days = checks.real(days, "days", low=0.0, low_open=True, high=3650.0 * DAYS_PER_YEAR,
                        units="d")
     factor = check_measure(ds, curve, name)
+    # the risk of an earlier hazard (a file written here, given again) is replaced, not mixed
+    earlier = [v for v in ds.variables if str(v).startswith(("risk_", "hazard_"))]
+    ds = ds.drop_vars(earlier)
+    ds.attrs = {k: v for k, v in ds.attrs.items()
+                if not k.startswith(("risk_", "hazard_")) and k != "docking_days"}
     dims = ds["median"].dims
     theta = ds["median"].values * factor
     beta = ds["beta"].values
@@ -349,11 +354,11 @@ def run_risk(results, hazard, days: float, *, output=None, site=None, format: st
     days : float
         Docking period [d].
     output : str or os.PathLike, optional
-        Where to write; default ``<results stem>_risk.nc`` beside the results. ``False``-like
-        ``""`` writes nothing.
+        Where to write; default ``<results stem>_risk.nc`` beside the results; ``""`` writes
+        nothing (the dataset is only returned).
     site, format, measure
-        Passed to :func:`~shipblock.risk.hazard.read_hazard_curve`; ``measure`` defaults to the
-        study's.
+        Passed to :func:`~shipblock.risk.hazard.read_hazard_curve`; for a file with curves of
+        several measures and no ``measure``, the study's is taken.
     band : bool
         Also the bootstrap band.
 
