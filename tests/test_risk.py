@@ -324,6 +324,26 @@ def test_study_risk_equals_the_integral_of_each_fit_with_a_reproduced_band(study
         np.testing.assert_allclose(back["risk_annual_rate"].values, expected, rtol=1e-12)
 
 
+def test_msa_band_is_made_again_and_a_study_without_bands_says_so(tmp_path):
+    path = write_pipeline(tmp_path, kind="msa", n_records=6,
+                          levels="levels_g = [0.2, 0.3, 0.35, 0.4, 0.45, 0.5, 0.6, 0.8]")
+    ds = run_pipeline(path, progress=False)
+    banded = np.isfinite(ds["median_lower"].values)
+    assert banded.any()
+    curve = read_hazard_curve(PGA_CURVES, site="Seattle WA")
+    out = risk_dataset(ds, curve, 120)
+    assert out.attrs["risk_band"] == "bootstrap replicates of the fits"
+    lo, hi = out["risk_annual_rate_lower"].values, out["risk_annual_rate_upper"].values
+    assert np.all(lo[banded] < out["risk_annual_rate"].values[banded])
+    assert np.all(out["risk_annual_rate"].values[banded] < hi[banded])
+    unbanded = ds.copy()
+    for name in ("median_lower", "median_upper"):
+        unbanded[name] = ds[name] * np.nan
+    out = risk_dataset(unbanded, curve, 120)
+    assert out.attrs["risk_band"] == "none: no fit of the study has a bootstrap band"
+    assert "risk_annual_rate_lower" not in out
+
+
 def test_risk_of_a_risk_file_replaces_the_earlier_hazard(study, tmp_path):
     _, results, _ = study
     first = run_risk(results, PGA_CURVES, 120, site="Seattle WA", output=tmp_path / "a.nc",

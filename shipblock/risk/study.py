@@ -163,6 +163,7 @@ def bootstrap_replicates(ds: xr.Dataset):
     confidence = float(fit_opts["confidence"])
     q = 100 * np.array([(1 - confidence) / 2, (1 + confidence) / 2])
     levels = ds["im_level"].values / factor if "im_level" in ds.dims else None
+    n_done = 0
     for i, ls in enumerate(ds["limit_state"].values):
         lead = ["record", "im_level"] if levels is not None else ["record"]
         e_all = ds["exceeded"].sel(limit_state=ls).transpose(*lead, *sweep).values
@@ -210,6 +211,9 @@ def bootstrap_replicates(ds: xr.Dataset):
                                     f"{bounds} instead of the stored {stored}: the band is left out")
             medians[index][: m.size] = m
             betas[index][: m.size] = b.betas
+            n_done += 1
+    if not n_done:
+        return None, None, "no fit of the study has a bootstrap band"
     return medians, betas, ""
 
 
