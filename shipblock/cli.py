@@ -1,4 +1,4 @@
-"""The ``shipblock`` command: simulate, process, info, run, history, plot, bench.
+"""The ``shipblock`` command: simulate, process, info, catalogue, run, history, plot, risk, select, bench.
 
 The command only parses arguments, calls the library and prints; every computation lives in the
 library. User errors print one line ``shipblock: error: ...`` and exit with status 2.
@@ -551,6 +551,58 @@ def cmd_plot(args):
     return 0
 
 
+def cmd_risk(args):
+    from shipblock.risk.study import risk_lines, run_risk
+
+    ds = run_risk(args.results, args.hazard, args.days, output=args.output, site=args.site,
+                  format=args.format, measure=args.measure, band=not args.no_band)
+    out = sys.stdout
+    out.write(f"risk written to {ds.encoding['source']}\n")
+    for line in risk_lines(ds, args.target_probability):
+        out.write(line + "\n")
+    if args.figure:
+        from shipblock.plot_risk import plot_risk
+
+        _save_figure(lambda: plot_risk(ds)[0].figure, args.figure)
+        out.write(f"figure written to {args.figure}\n")
+    return 0
+
+
+def cmd_select(args):
+    from shipblock.catalogue import load_catalogue
+    from shipblock.risk.selection import (
+        select_records,
+        selection_lines,
+        selection_toml,
+        target_from_file,
+    )
+
+    entries = load_catalogue(args.catalogue)
+    target = target_from_file(args.target, args.units)
+    vertical = (None if args.vertical_target is None
+                else target_from_file(args.vertical_target, args.vertical_units or args.units))
+    selection = select_records(
+        entries, target, args.k, period_range=args.period_range, vertical_target=vertical,
+        vertical_weight=args.vertical_weight, scale=not args.no_scale,
+        min_scale_factor=args.min_scale_factor, max_scale_factor=args.max_scale_factor,
+        horizontal=args.horizontal, azimuth=args.azimuth,
+        processing=[] if args.no_processing else None)
+    output = Path(args.output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    partial = output.with_name(output.name + ".part")
+    partial.write_text(selection_toml(selection, entries, output))
+    try:
+        load_catalogue(partial)  # what is written reads back
+    except Exception:
+        partial.unlink()
+        raise
+    partial.replace(output)
+    sys.stdout.write(f"selection written to {output}\n")
+    for line in selection_lines(selection):
+        sys.stdout.write(line + "\n")
+    return 0
+
+
 def cmd_bench(args):
     if args.read:
         import json
@@ -675,6 +727,64 @@ def build_parser():
                    help="with --kind median: the swept parameter on the x axis (default: the "
                         "first)")
     s.set_defaults(func=cmd_plot)
+
+    s = sub.add_parser("risk", help="risk over a docking period: fragility x site hazard",
+                       description="Convolve every fitted fragility of a result with a site "
+                       "hazard curve: annual rate of exceedance, return period, probability "
+                       "during the docking period (Poisson), bootstrap band and deaggregation "
+                       "over the intensity; written to a copy of the result.")
+    s.add_argument("results", help="NetCDF written by 'shipblock run'")
+    s.add_argument("--hazard", required=True, metavar="FILE",
+                   help="hazard curve: OpenQuake hazard_curve CSV, USGS nshmp-haz CSV, USGS "
+                        "hazard service JSON, or a two-column table with units in its header")
+    s.add_argument("--days", required=True, type=float, help="docking period [d]")
+    s.add_argument("--site", help="site of a file with several: its name or LON,LAT [deg]")
+    s.add_argument("--format", default="auto",
+                   choices=["auto", "openquake", "nshmp-csv", "usgs-json", "table"],
+                   help="layout of the hazard file (default: told from the file)")
+    s.add_argument("--measure", help="IMT of the hazard file when it does not say (e.g. PGA, "
+                                     "SA1P0)")
+    s.add_argument("--output", "-o", help="NetCDF to write (default: <results>_risk.nc)")
+    s.add_argument("--figure", help="PNG of the hazard, fragilities and deaggregation")
+    s.add_argument("--no-band", action="store_true",
+                   help="skip the bootstrap band (the replicates are made again)")
+    s.add_argument("--target-probability", type=float, metavar="P",
+                   help="acceptable probability during the docking period: each fit (its upper "
+                        "bound) is marked below or above it")
+    s.set_defaults(func=cmd_risk)
+
+    s = sub.add_parser("select", help="choose the records of a catalogue that best match a "
+                                      "target spectrum",
+                       description="Rank the records of a catalogue by the misfit of their "
+                       "spectra (horizontal, and vertical with --vertical-target) to a target "
+                       "over a period range, each scaled by its best factor within bounds; "
+                       "write the best k as a catalogue a pipeline reads, with the ASCE 7-16 "
+                       "suite-mean check.")
+    s.add_argument("catalogue", help="catalogue TOML (e.g. from 'shipblock catalogue')")
+    s.add_argument("--target", required=True, metavar="FILE",
+                   help="target spectrum: two columns, period [s] and Sa (uniform hazard or "
+                        "conditional mean); the Sa unit from --units or the header, e.g. "
+                        "'period [s], Sa [g]'")
+    s.add_argument("--units", help="unit of the target's Sa (g, m/s^2, ...)")
+    s.add_argument("-k", type=int, default=7, help="number of records to choose (default 7)")
+    s.add_argument("--output", "-o", default="selected.toml", help="catalogue TOML to write")
+    s.add_argument("--period-range", nargs=2, type=float, metavar=("TA", "TB"),
+                   help="periods compared [s] (default: the target's range)")
+    s.add_argument("--vertical-target", metavar="FILE", help="target spectrum of the vertical")
+    s.add_argument("--vertical-units", help="unit of its Sa (default --units or its header)")
+    s.add_argument("--vertical-weight", type=float, default=1.0,
+                   help="weight of the vertical misfit (default 1)")
+    s.add_argument("--horizontal", default="H1", choices=["H1", "H2", "geomean"],
+                   help="horizontal spectrum compared (default H1, as a pipeline's default)")
+    s.add_argument("--azimuth", type=float,
+                   help="dock transverse axis [deg from north]: horizontals rotated onto it "
+                        "(instead of --horizontal)")
+    s.add_argument("--no-scale", action="store_true", help="compare the records unscaled")
+    s.add_argument("--min-scale-factor", type=float, default=0.25, help="default 0.25")
+    s.add_argument("--max-scale-factor", type=float, default=4.0, help="default 4")
+    s.add_argument("--no-processing", action="store_true",
+                   help="spectra of the records as read (default: the default processing chain)")
+    s.set_defaults(func=cmd_select)
 
     s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "
                                      "batch scaling")

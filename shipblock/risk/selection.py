@@ -1,0 +1,507 @@
+r"""Record selection for a target spectrum: the k records of a catalogue that match it best.
+
+Every record of a catalogue is read, processed (the default chain unless another is given, as
+a pipeline would) and its 5 %-damped pseudo-acceleration spectra computed
+(:func:`shipblock.intensity.spectral_acceleration`) on ``n_periods`` periods :math:`T_i`
+log-spaced over the period range :math:`[T_a, T_b]`: of the horizontal the study will use
+(``"H1"``, ``"H2"``, or ``"geomean"``, the geometric mean of the two) and, when a vertical
+target is given, of the vertical. One factor :math:`f` scales both components (the V/H ratio
+of the record is kept, as ``vertical = "same"`` in a pipeline). With the log residuals
+
+.. math:: r^H_i(f) = \ln\frac{f\,S^H(T_i)}{S^{H*}(T_i)}, \qquad
+          r^V_i(f) = \ln\frac{f\,S^V(T_i)}{S^{V*}(T_i)},
+
+the misfit of a record is the weighted RMS
+
+.. math:: \varepsilon(f) = \sqrt{\frac{\sum_i (r^H_i)^2 + w \sum_i (r^V_i)^2}{n (1 + w)}}
+
+(:math:`w` = ``vertical_weight``, 0 without a vertical target). It is quadratic in
+:math:`\ln f`, so its minimum is the weighted mean of the log ratios,
+
+.. math:: \ln f^\star = \frac{\sum_i \ln(S^{H*}_i/S^H_i) + w \sum_i \ln(S^{V*}_i/S^V_i)}
+          {n(1 + w)},
+
+and within bounds :math:`[f_{min}, f_{max}]` the bounded minimum is :math:`f^\star` clipped to
+them (a convex function of one variable). Without scaling :math:`f = 1`. The k records of least
+misfit are the suite.
+
+**Suite mean (ASCE 7-16 §16.2.3).** The arithmetic mean of the suite's scaled horizontal
+spectra must not fall below 90 % of the target anywhere in the period range. If it does and
+scaling is on, every factor is raised by the common ratio that lifts the lowest point to 90 %
+(within ``max_scale_factor``; the report says if the bound prevents it). ASCE 7-16 states the
+check on maximum-direction spectra; here it is made on the component the study applies (or the
+geometric mean), which is what the ship-block model sees.
+
+The suite is written as a catalogue (:func:`selection_toml`): the chosen records' tables with
+paths relative to the new file, each with ``selection_rank``, ``selection_scale_factor`` and
+``selection_misfit``; a pipeline reads it with ``ids = "all"``.
+
+References
+----------
+.. [1] ASCE/SEI 7-16 (2017). *Minimum Design Loads and Associated Criteria for Buildings and
+   Other Structures*, §16.2.3 (selection and amplitude scaling of ground motions).
+.. [2] Baker, J. W. and Lee, C. (2018). An improved algorithm for selecting ground motions to
+   match a conditional spectrum. *J. Earthquake Eng.* 22(4), 708-723 (selection by the sum of
+   squared log residuals).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from shipblock import checks, intensity
+from shipblock.catalogue import CatalogueEntry, _relative, _toml_value, load_catalogue
+from shipblock.errors import ParameterError, ShipblockError
+from shipblock.processing import process_motion
+from shipblock.scaling import TargetSpectrum, read_target_spectrum
+
+__all__ = [
+    "ASCE_SUITE_FLOOR",
+    "RecordMatch",
+    "Selection",
+    "match_record",
+    "select_records",
+    "selection_lines",
+    "selection_toml",
+    "target_from_file",
+]
+
+#: Lowest ratio of the suite's mean spectrum to the target over the range (ASCE 7-16 §16.2.3).
+ASCE_SUITE_FLOOR = 0.9
+
+#: Default number of periods the spectra are compared on [-].
+DEFAULT_PERIODS = 30
+
+#: Horizontal spectra a selection can compare.
+HORIZONTALS = ("H1", "H2", "geomean")
+
+
+@dataclass(frozen=True)
+class RecordMatch:
+    """One record's spectra and its best factor to the target.
+
+    Attributes
+    ----------
+    id : str
+        Catalogue id.
+    factor : float
+        Scale factor of both components [-].
+    misfit, misfit_h, misfit_v : float
+        Combined, horizontal and vertical RMS log residual at ``factor`` [-] (``misfit_v`` NaN
+        without a vertical target).
+    sa_h, sa_v : numpy.ndarray
+        Unscaled spectra on the selection's periods [m/s^2] (``sa_v`` None without a vertical
+        target).
+    bounded : bool
+        Whether the factor sits on a bound (the unbounded optimum was outside).
+    """
+
+    id: str
+    factor: float
+    misfit: float
+    misfit_h: float
+    misfit_v: float
+    sa_h: np.ndarray
+    sa_v: np.ndarray | None
+    bounded: bool = False
+
+
+@dataclass
+class Selection:
+    """The chosen suite and every record's match.
+
+    Attributes
+    ----------
+    chosen : list of RecordMatch
+        The k best, best first, with the suite's common factor applied.
+    ranked : list of RecordMatch
+        Every record that could be matched, best first (factors before the suite factor).
+    failures : dict
+        Record id -> why it could not be used.
+    periods : numpy.ndarray
+        Comparison periods [s].
+    target_h, target_v : numpy.ndarray
+        Targets there [m/s^2] (``target_v`` None without a vertical target).
+    suite_mean_h, suite_mean_v : numpy.ndarray
+        Mean of the chosen records' scaled spectra [m/s^2].
+    suite_ratio_min : float
+        Lowest ``suite_mean_h / target_h`` over the range [-].
+    suite_ratio_period : float
+        Where it is [s].
+    suite_factor : float
+        Common factor applied to every chosen record to reach the floor (1 if not needed).
+    passes : bool
+        ``suite_ratio_min >= 0.9`` (ASCE 7-16 §16.2.3).
+    options : dict
+        The selection's settings, for the written catalogue.
+    """
+
+    chosen: list
+    ranked: list
+    failures: dict
+    periods: np.ndarray
+    target_h: np.ndarray
+    target_v: np.ndarray | None
+    suite_mean_h: np.ndarray
+    suite_mean_v: np.ndarray | None
+    suite_ratio_min: float
+    suite_ratio_period: float
+    suite_factor: float
+    passes: bool
+    options: dict = field(default_factory=dict)
+
+
+def target_from_file(path, units: str | None = None) -> TargetSpectrum:
+    """Read a target spectrum (period [s], Sa) whose Sa unit is given or in its header.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Two columns (see :func:`shipblock.scaling.read_target_spectrum`).
+    units : str, optional
+        Unit of Sa; default: the bracketed unit of the header's second column, e.g.
+        ``period [s], Sa [g]``.
+
+    Returns
+    -------
+    TargetSpectrum
+        [m/s^2].
+
+    Raises
+    ------
+    ParameterError
+        If no unit is given and the header states none.
+    """
+    path = checks.existing_file(path, "target", "a target spectrum file (period [s], Sa)")
+    if units is None:
+        first = next((ln.split("#", 1)[0] for ln in Path(path).read_text().splitlines()
+                      if ln.split("#", 1)[0].strip()), "")
+        found = re.findall(r"\[([^\]]+)\]", first)
+        if len(found) < 2:
+            raise ParameterError(f"{path}: give the unit of Sa (units, --units) or write it in "
+                                 f"the header, e.g. 'period [s], Sa [g]'; got {first.strip()!r}")
+        units = found[1].strip()
+    return read_target_spectrum(path, units)
+
+
+def _horizontal(motion, horizontal: str | None, periods, damping):
+    if horizontal is None:  # the motion's own horizontal: rotated to the dock's azimuth
+        return intensity.spectral_acceleration(motion.horizontal, motion.dt, periods, damping)
+    comps = motion.components
+    if horizontal == "geomean":
+        if "H1" not in comps or "H2" not in comps:
+            raise ShipblockError("needs both horizontals for horizontal = 'geomean'")
+        return np.sqrt(intensity.spectral_acceleration(comps["H1"], motion.dt, periods, damping)
+                       * intensity.spectral_acceleration(comps["H2"], motion.dt, periods,
+                                                         damping))
+    if horizontal not in comps:
+        raise ShipblockError(f"has no {horizontal} component")
+    return intensity.spectral_acceleration(comps[horizontal], motion.dt, periods, damping)
+
+
+def match_record(record_id, sa_h, sa_v, target_h, target_v, *, vertical_weight=1.0,
+                 scale=True, min_scale_factor=0.25, max_scale_factor=4.0) -> RecordMatch:
+    r"""Best factor and misfit of one record's spectra to the targets (see the module text).
+
+    Parameters
+    ----------
+    record_id : str
+    sa_h, target_h : array_like
+        Horizontal spectrum and target on the same periods [m/s^2], positive.
+    sa_v, target_v : array_like or None
+        The same for the vertical (both None: horizontal only).
+    vertical_weight : float
+        :math:`w` [-], >= 0.
+    scale : bool
+        Scale (else ``f = 1``).
+    min_scale_factor, max_scale_factor : float
+        Bounds of ``f`` [-].
+
+    Returns
+    -------
+    RecordMatch
+    """
+    sa_h, target_h = np.asarray(sa_h, float), np.asarray(target_h, float)
+    log_h = np.log(target_h / sa_h)
+    w = 0.0 if target_v is None else float(vertical_weight)
+    log_v = np.log(np.asarray(target_v, float) / np.asarray(sa_v, float)) if w else None
+    bounded = False
+    if scale:
+        total = log_h.sum() + (w * log_v.sum() if w else 0.0)
+        log_f = total / (log_h.size + (w * log_v.size if w else 0.0))
+        low, high = np.log(min_scale_factor), np.log(max_scale_factor)
+        bounded = not low <= log_f <= high
+        log_f = float(np.clip(log_f, low, high))
+    else:
+        log_f = 0.0
+    r_h = log_f - log_h
+    misfit_h = float(np.sqrt(np.mean(r_h**2)))
+    if w:
+        r_v = log_f - log_v
+        misfit_v = float(np.sqrt(np.mean(r_v**2)))
+        misfit = float(np.sqrt((np.sum(r_h**2) + w * np.sum(r_v**2))
+                               / (r_h.size + w * r_v.size)))
+    else:
+        misfit_v = float("nan") if target_v is None else float(np.sqrt(np.mean(
+            (log_f - np.log(np.asarray(target_v, float) / np.asarray(sa_v, float))) ** 2)))
+        misfit = misfit_h
+    return RecordMatch(str(record_id), float(np.exp(log_f)), misfit, misfit_h, misfit_v,
+                       sa_h, None if sa_v is None else np.asarray(sa_v, float), bounded)
+
+
+def select_records(catalogue, target, k: int, *, period_range=None, vertical_target=None,
+                   vertical_weight: float = 1.0, scale: bool = True,
+                   min_scale_factor: float = 0.25, max_scale_factor: float = 4.0,
+                   horizontal: str = "H1", azimuth: float | None = None,
+                   damping: float = intensity.DEFAULT_DAMPING,
+                   n_periods: int = DEFAULT_PERIODS, processing=None, ids=None,
+                   suite_floor: bool = True) -> Selection:
+    """Choose the ``k`` records of a catalogue that best match a target spectrum.
+
+    Parameters
+    ----------
+    catalogue : str or os.PathLike or dict or None
+        A catalogue TOML, or the entries of :func:`shipblock.catalogue.load_catalogue`; None:
+        the shipped catalogue.
+    target : TargetSpectrum or str or os.PathLike
+        Horizontal target (a file as :func:`target_from_file`, unit in its header).
+    k : int
+        Number of records to choose, >= 1.
+    period_range : tuple of float, optional
+        :math:`(T_a, T_b)` [s]; default the target's whole range (and the vertical's).
+    vertical_target : TargetSpectrum or path, optional
+        Vertical target; then the vertical spectra count with ``vertical_weight``.
+    vertical_weight : float
+        :math:`w` [-].
+    scale : bool
+        Scale each record (one factor for both components); else unscaled.
+    min_scale_factor, max_scale_factor : float
+        Bounds of the factor [-] (ASCE-style practice keeps them within about 0.25 to 4).
+    horizontal : {"H1", "H2", "geomean"}
+        Horizontal spectrum compared (the study's component, or the geometric mean).
+    azimuth : float, optional
+        Dock transverse axis [deg clockwise from north]: the horizontals rotated onto it, as a
+        pipeline's ``records.azimuth`` (replaces ``horizontal``).
+    damping : float
+        Fraction of critical damping of the spectra [-].
+    n_periods : int
+        Comparison periods, log-spaced [-].
+    processing : list of dict, optional
+        Processing chain before the spectra (default :data:`shipblock.processing.DEFAULT_CHAIN`;
+        ``[]`` for none).
+    ids : list of str, optional
+        Only these catalogue records (default all).
+    suite_floor : bool
+        Raise the suite's factors to meet the 90 % floor when scaling.
+
+    Returns
+    -------
+    Selection
+
+    Raises
+    ------
+    ParameterError
+        Naming the argument: ``k`` larger than the records that could be matched, a bad range,
+        factor bounds or horizontal.
+    """
+    entries = catalogue if isinstance(catalogue, dict) else load_catalogue(catalogue)
+    k = checks.whole(k, "k", low=1, high=10_000)
+    horizontal = checks.choice(horizontal, "horizontal", HORIZONTALS)
+    if azimuth is not None:
+        azimuth = checks.azimuth(azimuth, "azimuth")
+    vertical_weight = checks.real(vertical_weight, "vertical_weight", low=0.0)
+    min_scale_factor = checks.real(min_scale_factor, "min_scale_factor", low=0.0, low_open=True)
+    max_scale_factor = checks.real(max_scale_factor, "max_scale_factor", low=min_scale_factor)
+    n_periods = checks.whole(n_periods, "n_periods", low=2, high=1000)
+    if not isinstance(target, TargetSpectrum):
+        target = target_from_file(target)
+    if vertical_target is not None and not isinstance(vertical_target, TargetSpectrum):
+        vertical_target = target_from_file(vertical_target)
+    if period_range is None:
+        lo, hi = target.periods[0], target.periods[-1]
+        if vertical_target is not None:
+            lo, hi = max(lo, vertical_target.periods[0]), min(hi, vertical_target.periods[-1])
+        period_range = (lo, hi)
+    try:
+        ta, tb = (float(x) for x in period_range)
+    except (TypeError, ValueError):
+        raise ParameterError(f"period_range must be two periods [s], got {period_range!r}") \
+            from None
+    if not (checks.MIN_PERIOD <= ta < tb <= checks.MAX_PERIOD):
+        raise ParameterError(f"period_range must satisfy 0 < T_a < T_b [s], got {period_range!r}")
+    periods = np.geomspace(ta, tb, n_periods)
+    target_h = target.at(periods)
+    target_v = None if vertical_target is None else vertical_target.at(periods)
+    wanted = list(entries) if ids is None else list(ids)
+    unknown = [i for i in wanted if i not in entries]
+    if unknown:
+        raise ParameterError(f"ids: not in the catalogue: {', '.join(unknown)}")
+    ranked, failures = [], {}
+    for record_id in wanted:
+        entry = entries[record_id]
+        try:
+            motion = process_motion(entry.read(azimuth=azimuth), processing)
+            sa_h = _horizontal(motion, None if azimuth is not None else horizontal, periods,
+                               damping)
+            sa_v = None
+            if target_v is not None:
+                if motion.vertical is None:
+                    raise ShipblockError("has no vertical component (a vertical target is given)")
+                sa_v = intensity.spectral_acceleration(motion.vertical, motion.dt, periods,
+                                                       damping)
+            if np.any(sa_h <= 0) or (sa_v is not None and np.any(sa_v <= 0)):
+                raise ShipblockError(f"has zero Sa between {ta:g} and {tb:g} s")
+        except (ShipblockError, ValueError, OSError) as exc:
+            failures[record_id] = str(exc)
+            continue
+        ranked.append(match_record(record_id, sa_h, sa_v, target_h, target_v,
+                                   vertical_weight=vertical_weight, scale=scale,
+                                   min_scale_factor=min_scale_factor,
+                                   max_scale_factor=max_scale_factor))
+    if k > len(ranked):
+        raise ParameterError(f"k = {k} but only {len(ranked)} records could be matched"
+                             + (f" ({len(failures)} not: {failures})" if failures else ""))
+    ranked.sort(key=lambda m: (m.misfit, m.id))
+    chosen = ranked[:k]
+    factors = np.array([m.factor for m in chosen])
+    mean_h = np.mean([m.factor * m.sa_h for m in chosen], axis=0)
+    ratio = mean_h / target_h
+    suite_factor = 1.0
+    if scale and suite_floor and ratio.min() < ASCE_SUITE_FLOOR:
+        suite_factor = min(ASCE_SUITE_FLOOR / ratio.min(), max_scale_factor / factors.max())
+        suite_factor = max(suite_factor, 1.0)
+    if suite_factor != 1.0:
+        chosen = [_rescaled(m, suite_factor, target_h, target_v, vertical_weight)
+                  for m in chosen]
+        mean_h = mean_h * suite_factor
+        ratio = mean_h / target_h
+    mean_v = None
+    if target_v is not None:
+        mean_v = np.mean([m.factor * m.sa_v for m in chosen], axis=0)
+    i_min = int(np.argmin(ratio))
+    options = {"k": k, "period_range_s": [ta, tb], "n_periods": n_periods,
+               "horizontal": horizontal if azimuth is None else f"azimuth {azimuth:g} deg",
+               "damping": damping, "scale": scale,
+               "min_scale_factor": min_scale_factor, "max_scale_factor": max_scale_factor,
+               "vertical_weight": vertical_weight if target_v is not None else 0.0,
+               "target": target.source,
+               "vertical_target": None if vertical_target is None else vertical_target.source}
+    return Selection(chosen, ranked, failures, periods, target_h, target_v, mean_h, mean_v,
+                     float(ratio[i_min]), float(periods[i_min]), float(suite_factor),
+                     bool(ratio[i_min] >= ASCE_SUITE_FLOOR * (1 - 1e-12)), options)
+
+
+def _rescaled(m: RecordMatch, c: float, target_h, target_v, w) -> RecordMatch:
+    """``m`` with its factor times ``c`` and the misfits at the new factor."""
+    again = match_record(m.id, m.sa_h, m.sa_v, target_h / (m.factor * c), None if target_v is None
+                         else target_v / (m.factor * c), vertical_weight=w, scale=False)
+    return RecordMatch(m.id, m.factor * c, again.misfit, again.misfit_h, again.misfit_v,
+                       m.sa_h, m.sa_v, m.bounded)
+
+
+def _inline(value) -> str:
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{_toml_value(str(k))} = {_inline(v)}"
+                               for k, v in value.items()) + "}"
+    return _toml_value(value)
+
+
+def _entry_lines(entry: CatalogueEntry, base: Path, extra: dict) -> list[str]:
+    table = {"id": entry.id, "files": [_relative(f, base) for f in entry.files]}
+    if entry.inventory is not None:
+        table["inventory"] = _relative(entry.inventory, base)
+    if entry.event is not None:
+        table["event"] = _relative(entry.event, base)
+    for key in ("network", "station", "site", "license", "credit"):
+        if getattr(entry, key):
+            table[key] = getattr(entry, key)
+    table["station"] = entry.station
+    if entry.units:
+        table["units"] = entry.units
+    table.update({k: v for k, v in entry.extra.items() if not k.startswith("selection_")})
+    table.update(extra)
+    lines = ["[[record]]"] + [f"{k} = {_inline(v)}" for k, v in table.items()
+                              if v is not None]
+    if entry.components:
+        lines += ["[record.components]"]
+        lines += [f"{_toml_value(k)} = {_toml_value(v)}" for k, v in entry.components.items()]
+    return lines + [""]
+
+
+def selection_toml(selection: Selection, entries: dict, output) -> str:
+    """The chosen suite as a catalogue TOML (paths relative to ``output``'s folder).
+
+    Parameters
+    ----------
+    selection : Selection
+    entries : dict
+        The catalogue's entries (:func:`~shipblock.catalogue.load_catalogue`).
+    output : str or os.PathLike
+        Where it will be written.
+
+    Returns
+    -------
+    str
+    """
+    base = Path(checks.pathname(output, "output", "the catalogue to write")).resolve().parent
+    o = selection.options
+    lines = [
+        "# Records selected by 'shipblock select' (shipblock.risk.selection) for the target",
+        f"# {o['target']} over {o['period_range_s'][0]:g} to {o['period_range_s'][1]:g} s "
+        f"({o['horizontal']} horizontal"
+        + (f"; vertical target {o['vertical_target']}, weight {o['vertical_weight']:g}"
+           if o["vertical_target"] else "") + ").",
+        ("# Scale factors bounded to " + format(o["min_scale_factor"], "g") + " .. "
+         + format(o["max_scale_factor"], "g") if o["scale"] else
+         "# Scale factors not applied (unscaled)")
+        + f"; suite factor {selection.suite_factor:.4g}.",
+        f"# Suite mean / target: lowest {selection.suite_ratio_min:.3f} at "
+        f"{selection.suite_ratio_period:.3g} s: ASCE 7-16 §16.2.3 90 % check "
+        f"{'passed' if selection.passes else 'FAILED'}.",
+        "# selection_scale_factor is the factor that matches the target; a pipeline scales the "
+        "records itself",
+        "# to its IM levels (read this catalogue with ids = \"all\").",
+        "", "schema_version = 1", "",
+    ]
+    for rank, m in enumerate(selection.chosen, start=1):
+        extra = {"selection_rank": rank, "selection_scale_factor": m.factor,
+                 "selection_misfit": m.misfit, "selection_misfit_h": m.misfit_h}
+        if np.isfinite(m.misfit_v):
+            extra["selection_misfit_v"] = m.misfit_v
+        lines += _entry_lines(entries[m.id], base, extra)
+    return "\n".join(lines)
+
+
+def selection_lines(selection: Selection) -> list[str]:
+    """What ``shipblock select`` prints: the suite, each record's factor and misfit, the check."""
+    o = selection.options
+    lines = [f"{len(selection.chosen)} of {len(selection.ranked)} records chosen "
+             f"({o['horizontal']} horizontal"
+             + (", with the vertical" if o["vertical_target"] else "") + f", "
+             f"{o['period_range_s'][0]:g} to {o['period_range_s'][1]:g} s)"]
+    header = f"  {'rank':>4}  {'record':<32} {'factor':>8} {'misfit':>8} {'misfit H':>9}"
+    if o["vertical_target"]:
+        header += f" {'misfit V':>9}"
+    lines.append(header)
+    for rank, m in enumerate(selection.chosen, start=1):
+        row = (f"  {rank:>4}  {m.id:<32} {m.factor:>8.3f} {m.misfit:>8.3f} {m.misfit_h:>9.3f}")
+        if o["vertical_target"]:
+            row += f" {m.misfit_v:>9.3f}"
+        if m.bounded:
+            row += "  (factor at its bound)"
+        lines.append(row)
+    if selection.suite_factor != 1.0:
+        lines.append(f"suite factor {selection.suite_factor:.4g} applied to reach the 90 % floor")
+    if not selection.passes and o["scale"]:
+        lines.append(f"the factors cannot rise further: max_scale_factor = "
+                     f"{o['max_scale_factor']:g} (or choose other records)")
+    lines.append(f"suite mean / target: lowest {selection.suite_ratio_min:.3f} at "
+                 f"{selection.suite_ratio_period:.3g} s: ASCE 7-16 §16.2.3 90 % check "
+                 f"{'passed' if selection.passes else 'FAILED'}")
+    for record_id, why in selection.failures.items():
+        lines.append(f"not used: {record_id}: {why}")
+    return lines
