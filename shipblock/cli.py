@@ -569,7 +569,7 @@ def cmd_risk(args):
 
 
 def cmd_select(args):
-    from shipblock.catalogue import load_catalogue
+    from shipblock.records.catalogue import load_catalogue
     from shipblock.risk.selection import (
         select_records,
         selection_lines,

@@ -373,7 +373,7 @@ def _select_sweep(da, sweep):
     return da
 
 
-def _sweep_text(sweep) -> str:
+def sweep_text(sweep) -> str:
     return ", ".join(f"{k} = {v:g}" if isinstance(v, float | int | np.number) else f"{k} = {v}"
                      for k, v in (sweep or {}).items())
 
@@ -503,7 +503,7 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
         parts.append(f"{int(ds['valid'].sel(limit_state=names[0]).pipe(_select_sweep, sweep).sum())}"
                      " records")
     if sweep:
-        parts.append(_sweep_text(sweep))
+        parts.append(sweep_text(sweep))
     band = "; shaded: bootstrap band of the median" if "median_lower" in ds else ""
     ax.set_title("fragility: lognormal fit (lines), observed fractions (markers)" + band
                  + ("\n" + "; ".join(parts) if parts else ""), fontsize=9)
@@ -580,7 +580,7 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
     band = " (bars: bootstrap band)" if "median_lower" in ds else ""
     title = f"fitted median against {parameter}{band}"
     if others:
-        title += "\n" + _sweep_text(others)
+        title += "\n" + sweep_text(others)
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=7.5)
     return ax
@@ -627,7 +627,7 @@ def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
     ax.set_xlabel(f"{ds[edp].attrs.get('long_name', edp)} [{unit_label}]")
     ax.set_ylabel(ylabel)
     ax.grid(True, lw=0.3, alpha=0.5)
-    ax.set_title("IDA curves (x: failure)" + (f"; {_sweep_text(sweep)}" if sweep else ""),
+    ax.set_title("IDA curves (x: failure)" + (f"; {sweep_text(sweep)}" if sweep else ""),
                  fontsize=9)
     ax.legend(fontsize=8, ncol=2)
     return ax

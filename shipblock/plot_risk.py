@@ -13,7 +13,7 @@ from scipy.special import ndtr
 
 from shipblock.errors import ParameterError
 from shipblock.fragility.report import display_units
-from shipblock.plot import _sweep_text, sweep_selection
+from shipblock.plot import sweep_text, sweep_selection
 
 __all__ = ["plot_deaggregation", "plot_hazard_and_fragility", "plot_risk"]
 
@@ -96,7 +96,7 @@ def plot_deaggregation(ds, limit_state=None, ax=None, sweep=None):
         ax.legend(fontsize="small")
     title = "deaggregation over the intensity"
     if sweep:
-        title += f" ({_sweep_text(sweep)})"
+        title += f" ({sweep_text(sweep)})"
     ax.set_title(title, fontsize="medium")
     return ax
 

@@ -11,7 +11,7 @@ import pytest
 from obspy import Stream, Trace, UTCDateTime
 
 from shipblock import intensity
-from shipblock.catalogue import load_catalogue
+from shipblock.records.catalogue import load_catalogue
 from shipblock.cli import main
 from shipblock.errors import ParameterError
 from shipblock.fragility.pipeline import load_pipeline

@@ -22,7 +22,8 @@ from shipblock.records.motion import COMPONENTS, GroundMotion
 from shipblock.records.reading import read_motion
 from shipblock.units import STANDARD_GRAVITY
 
-__all__ = ["CatalogueEntry", "catalogue_toml", "default_catalogue_path", "load_catalogue"]
+__all__ = ["CatalogueEntry", "catalogue_toml", "default_catalogue_path", "load_catalogue", "relative_path",
+           "toml_value"]
 
 #: Catalogue layout version this module reads.
 SCHEMA_VERSION = 1
@@ -252,7 +253,7 @@ def load_catalogue(path=None) -> dict[str, CatalogueEntry]:
 # --------------------------------------------------------------------------------------------
 
 
-def _toml_value(value) -> str:
+def toml_value(value) -> str:
     """A TOML literal for a string, number or list of them (JSON's string escapes are TOML's)."""
     import json
     import math
@@ -264,11 +265,12 @@ def _toml_value(value) -> str:
             raise ValueError(f"cannot write {value!r} to TOML")
         return repr(float(value)) if isinstance(value, float) else str(value)
     if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
     return json.dumps(str(value), ensure_ascii=False)
 
 
-def _relative(path, base: Path) -> str:
+def relative_path(path, base: Path) -> str:
+    """``path`` relative to the folder ``base``, with forward slashes (as a catalogue stores it)."""
     import os
 
     return Path(os.path.relpath(Path(path).resolve(), base)).as_posix()
@@ -365,7 +367,7 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
             record_id += f"-{seen[record_id]}"
         table = {
             "id": record_id,
-            "files": [_relative(f, base) for f in md.get("source_files", [])],
+            "files": [relative_path(f, base) for f in md.get("source_files", [])],
             "network": station.get("network", ""),
             "station": station.get("station", ""),
             "location": station.get("location", ""),
@@ -377,7 +379,7 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
         }
         inventory = _inventory_file(motion, inventories) if md.get("inventory") else None
         if inventory is not None:
-            table["inventory"] = _relative(inventory, base)
+            table["inventory"] = relative_path(inventory, base)
         if units:
             table["units"] = units
         event = md.get("event") or {}
@@ -396,9 +398,9 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
             table[f"pga_{component}_m_s2"] = peak
             table[f"pga_{component}_g"] = peak / STANDARD_GRAVITY
         lines.append("[[record]]")
-        lines += [f"{key} = {_toml_value(value)}" for key, value in table.items()]
+        lines += [f"{key} = {toml_value(value)}" for key, value in table.items()]
         lines += ["", "[record.components]    # channel code -> component"]
         for component, seed_id in md.get("channels", {}).items():
-            lines.append(f"{_toml_value(seed_id)} = {_toml_value(component)}")
+            lines.append(f"{toml_value(seed_id)} = {toml_value(component)}")
         lines.append("")
     return "\n".join(lines)

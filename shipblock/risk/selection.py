@@ -54,7 +54,7 @@ from pathlib import Path
 import numpy as np
 
 from shipblock import checks, intensity
-from shipblock.catalogue import CatalogueEntry, _relative, _toml_value, load_catalogue
+from shipblock.records.catalogue import CatalogueEntry, load_catalogue, relative_path, toml_value
 from shipblock.errors import ParameterError, ShipblockError
 from shipblock.processing import process_motion
 from shipblock.scaling import TargetSpectrum, read_target_spectrum
@@ -265,7 +265,7 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
     Parameters
     ----------
     catalogue : str or os.PathLike or dict or None
-        A catalogue TOML, or the entries of :func:`shipblock.catalogue.load_catalogue`; None:
+        A catalogue TOML, or the entries of :func:`shipblock.records.catalogue.load_catalogue`; None:
         the shipped catalogue.
     target : TargetSpectrum or str or os.PathLike
         Horizontal target (a file as :func:`target_from_file`, unit in its header).
@@ -405,17 +405,17 @@ def _rescaled(m: RecordMatch, c: float, target_h, target_v, w) -> RecordMatch:
 
 def _inline(value) -> str:
     if isinstance(value, dict):
-        return "{" + ", ".join(f"{_toml_value(str(k))} = {_inline(v)}"
+        return "{" + ", ".join(f"{toml_value(str(k))} = {_inline(v)}"
                                for k, v in value.items()) + "}"
-    return _toml_value(value)
+    return toml_value(value)
 
 
 def _entry_lines(entry: CatalogueEntry, base: Path, extra: dict) -> list[str]:
-    table = {"id": entry.id, "files": [_relative(f, base) for f in entry.files]}
+    table = {"id": entry.id, "files": [relative_path(f, base) for f in entry.files]}
     if entry.inventory is not None:
-        table["inventory"] = _relative(entry.inventory, base)
+        table["inventory"] = relative_path(entry.inventory, base)
     if entry.event is not None:
-        table["event"] = _relative(entry.event, base)
+        table["event"] = relative_path(entry.event, base)
     for key in ("network", "station", "site", "license", "credit"):
         if getattr(entry, key):
             table[key] = getattr(entry, key)
@@ -428,7 +428,7 @@ def _entry_lines(entry: CatalogueEntry, base: Path, extra: dict) -> list[str]:
                               if v is not None]
     if entry.components:
         lines += ["[record.components]"]
-        lines += [f"{_toml_value(k)} = {_toml_value(v)}" for k, v in entry.components.items()]
+        lines += [f"{toml_value(k)} = {toml_value(v)}" for k, v in entry.components.items()]
     return lines + [""]
 
 
@@ -439,7 +439,7 @@ def selection_toml(selection: Selection, entries: dict, output) -> str:
     ----------
     selection : Selection
     entries : dict
-        The catalogue's entries (:func:`~shipblock.catalogue.load_catalogue`).
+        The catalogue's entries (:func:`~shipblock.records.catalogue.load_catalogue`).
     output : str or os.PathLike
         Where it will be written.
 
