@@ -713,6 +713,16 @@ def trim(stream, *, start=0.0, end=None):
     if len(stream) == 0:
         return
     t0 = min(tr.stats.starttime for tr in stream)
+    # obspy drops a trace the window misses entirely: name the window against the record instead
+    for tr in stream:
+        first = tr.stats.starttime - t0
+        last = tr.stats.endtime - t0
+        if t_start >= last:
+            raise ProcessingError("trim", f"start={t_start:g} s is at or after the end of trace"
+                                  f" {tr.id} ({last:.3f} s from the record's start)", "start")
+        if t_end is not None and t_end <= first:
+            raise ProcessingError("trim", f"end={t_end:g} s is at or before the start of trace"
+                                  f" {tr.id} ({first:.3f} s from the record's start)", "end")
     stream.trim(
         starttime=t0 + t_start,
         endtime=None if t_end is None else t0 + t_end,

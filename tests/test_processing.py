@@ -195,6 +195,16 @@ def test_trim_and_pad():
     np.testing.assert_array_equal(padded.data[50:1050], np.arange(1000.0))
 
 
+@pytest.mark.parametrize("window, key", [({"start": 10.0}, "start"),   # record is 9.99 s long
+                                         ({"start": 25.0, "end": 30.0}, "start"),
+                                         ({"start": 9.995}, "start")])
+def test_trim_beyond_the_record_names_the_window(window, key):
+    st = _stream({"HN1": np.arange(1000.0), "HNZ": np.arange(1000.0)}, 0.01)
+    with pytest.raises(P.ProcessingError, match="at or after the end of trace") as err:
+        P.trim(st, **window)
+    assert err.value.parameter == key and "9.990 s" in str(err.value)
+
+
 # ---------------------------------------------------------------------------------------------
 # registry, provenance, purity, errors
 # ---------------------------------------------------------------------------------------------
