@@ -260,6 +260,15 @@ def as_real_array(values, name: str, what: str, kinds: str = "iuf") -> np.ndarra
         return values  # the common case, at no cost
     if values is None or isinstance(values, str | bytes | dict | set):
         raise ParameterTypeError(f"{name} must be {what}, got {type(values).__name__}")
+    if isinstance(values, np.ma.MaskedArray):
+        # np.asarray would drop the mask and compute with whatever the masked slots hold
+        if np.ma.is_masked(values):
+            first = int(np.flatnonzero(np.ma.getmaskarray(values))[0])
+            raise ParameterError(
+                f"{name} has {int(np.ma.count_masked(values))} masked samples (the first at index"
+                f" {first}): fill them (values.filled(0.0) if the gap means no motion) or cut the"
+                " record around them")
+        values = values.data
     try:
         arr = np.asarray(values)
         if arr.dtype.kind not in kinds:

@@ -583,3 +583,19 @@ def test_reader_arguments_of_issue_23_raise_a_named_error(case, tmp_path, monkey
     make, kind, message = READER_CASES[case]
     with pytest.raises(kind, match=message):
         make()
+
+
+def test_masked_samples_are_refused_not_computed_with():
+    """A masked array's masked slots hold arbitrary values: simulating with them is refused by
+    name; an array whose mask hides nothing runs exactly as its data."""
+    system = ShipBlockSystem.example()
+    t = np.arange(2000) * 0.01
+    ah = 6.0 * np.sin(2 * np.pi * t)  # above the friction limit: the ship slides
+    masked = np.ma.masked_array(ah.copy(), mask=np.zeros(ah.size, bool))
+    masked.data[500:600] = 1e3  # what a gap's slots may hold
+    masked.mask[500:600] = True
+    with pytest.raises(ParameterError, match=r"100 masked samples \(the first at index 500\)"):
+        simulate(system, masked, dt=0.01)
+    clear = np.ma.masked_array(ah, mask=np.zeros(ah.size, bool))
+    np.testing.assert_array_equal(simulate(system, clear, dt=0.01).x_s,
+                                  simulate(system, ah, dt=0.01).x_s)
