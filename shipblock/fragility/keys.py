@@ -273,7 +273,8 @@ def check_table(table: Mapping, section: str, source: str, model: Model | None =
         dotted = f"{section}.{key}" if section else key
         if key not in declared:
             raise PipelineError(
-                dotted, f"unknown key {key!r}; allowed keys: {', '.join(declared)}", source
+                dotted, f"unknown key {key!r}; allowed keys: {', '.join(declared) or 'none'}",
+                source
             )
         try:
             declared[key].check_type(given, dotted)
