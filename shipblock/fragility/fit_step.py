@@ -103,11 +103,13 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
         ``bootstrap`` (resamples), ``confidence``, ``seed``, ``ida_method``, ``cloud_method``.
     store : ChunkStore, optional
         The run's partial-results directory (opened): fitted results are written to it as they
-        are done (at most every :data:`~shipblock.fragility.fit.checkpoint.FIT_CHECKPOINT_INTERVAL` seconds), and those it holds
-        from an interrupted run are used instead of fitted again. Each fit is a function of
+        are done (at most every
+        :data:`~shipblock.fragility.fit.checkpoint.FIT_CHECKPOINT_INTERVAL` seconds), and
+        those it holds from an interrupted run are used instead of fitted again. Each fit is a function of
         its own data and seed only, so the results are the same bit for bit.
     im_display : tuple of (str, float)
-        Unit the pipeline writes its IM in and its SI value (:attr:`Pipeline.im_display <shipblock.fragility.schema.Pipeline.im_display>`): the
+        Unit the pipeline writes its IM in and its SI value
+        (:attr:`Pipeline.im_display <shipblock.fragility.schema.Pipeline.im_display>`): the
         fits are made in it, so that their messages (``fit_error``) quote the levels as the
         pipeline wrote them, and with ``"g"`` the medians are stored in g too (``median_g``,
         ``median_lower_g``, ``median_upper_g``). Default: SI.

@@ -14,10 +14,12 @@ The dataset stores the levels, medians and achieved IMs in SI; with ``levels_g``
 medians also in g (``im_level_g``, ``median_g``, ...), and the fits, their messages and the
 command's output use the pipeline's unit.
 
-The names of the parser (:func:`load_pipeline`, :func:`parse_pipeline`, :class:`Pipeline`,
-:class:`PipelineError`, the ``MAX_*`` limits), of the fitting step
-(:func:`fragility_variables`) and of the reruns (:func:`rerun_case`) are importable from here
-as before.
+The names of the parser (:func:`~shipblock.fragility.schema.load_pipeline`,
+:func:`~shipblock.fragility.schema.parse_pipeline`, :class:`~shipblock.fragility.schema.Pipeline`,
+:class:`~shipblock.fragility.keys.PipelineError`, the ``MAX_*`` limits of
+:mod:`shipblock.fragility.keys`), of the fitting step
+(:func:`~shipblock.fragility.fit_step.fragility_variables`) and of the reruns
+(:func:`~shipblock.fragility.reruns.rerun_case`) are importable from here as before.
 """
 
 from __future__ import annotations
@@ -43,7 +45,7 @@ from shipblock.fragility.batch import (
     summary_dataset,
 )
 from shipblock.fragility.fit_step import fragility_variables, limit_state_coords
-from shipblock.fragility.keys import (
+from shipblock.fragility.keys import (  # noqa: F401  (importable from here as before)
     MAX_BOOTSTRAP,
     MAX_CHUNK_SIZE,
     MAX_HISTORIES,
@@ -53,13 +55,13 @@ from shipblock.fragility.keys import (
     PipelineError,
 )
 from shipblock.fragility.reruns import _rerun  # noqa: F401  (the CLI's rerun imports it here)
-from shipblock.fragility.reruns import (
+from shipblock.fragility.reruns import (  # noqa: F401  (rerun_case: importable as before)
     add_histories,
     match_target_spectrum,
     record_loader,
     rerun_case,
 )
-from shipblock.fragility.schema import (
+from shipblock.fragility.schema import (  # noqa: F401  (importable from here as before)
     HistoryRequest,
     Pipeline,
     load_pipeline,
@@ -76,23 +78,9 @@ from shipblock.fragility.store import (
 from shipblock.fragility.workers import Workers
 from shipblock.units import STANDARD_GRAVITY
 
-__all__ = [
-    "MAX_BOOTSTRAP",
-    "MAX_CHUNK_SIZE",
-    "MAX_HISTORIES",
-    "MAX_RUNS",
-    "MAX_SEED",
-    "SCHEMA_VERSION",
-    "HistoryRequest",
-    "Pipeline",
-    "PipelineError",
-    "fragility_variables",
-    "load_pipeline",
-    "parse_pipeline",
-    "records_used_message",
-    "rerun_case",
-    "run_pipeline",
-]
+# The parser's, the fitting step's and the reruns' names stay importable from here (documented
+# where they are defined).
+__all__ = ["records_used_message", "run_pipeline"]
 
 logger = logging.getLogger(__name__)
 

@@ -192,6 +192,9 @@ OPTIONS: Mapping[str, Field] = MappingProxyType({
                         high=MAX_ZENO_OMEGA),
 })
 
+# What a convenience multiplies to give the field it replaces.
+_FACTOR = {"half_width": "half_height", "block_mass": "ship_mass / n_blocks"}
+
 # Relations between parameters that no single range expresses: the parameter each names is
 # the one reported when ShipBlockSystem refuses the combination.
 _RELATIONS = (
@@ -302,9 +305,8 @@ class RigidModel(Model):
             try:
                 PARAMETERS[plain].check(table[plain])
             except FieldError as exc:
-                raise FieldError(conv, f"{plain} = {conv} x "
-                                 f"{'half_height' if plain == 'half_width' else 'ship_mass / n_blocks'}"
-                                 f" {exc.problem}") from None
+                raise FieldError(conv, f"{plain} = {conv} x {_FACTOR[plain]} "
+                                 f"{exc.problem}") from None
         try:
             return ShipBlockSystem(**table)
         except (TypeError, ValueError) as exc:
