@@ -45,14 +45,13 @@ import numpy as np
 
 from shipblock.errors import ParameterError
 from shipblock.models import DEFAULT_MODEL, Model, get_model
-from shipblock.models.base import EDPInfo
+from shipblock.models.base import EDPInfo  # noqa: F401  (importable from here as before)
 from shipblock.models.rigid import EDP_VARIABLES, FAILURE_CODES
 
 __all__ = [
     "CONDITIONS",
     "EDP_VARIABLES",
     "FAILURE_CODES",
-    "EDPInfo",
     "Exceedance",
     "LimitState",
     "evaluate_limit_states",
