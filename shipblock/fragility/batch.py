@@ -159,6 +159,7 @@ def prepare_record(
         level needs a scaled record above :data:`shipblock.checks.MAX_ACCELERATION`, 100 g,
         which :func:`~shipblock.scaling.scale_record` refuses).
     """
+    # the processing stack (obspy) loads when the first record is prepared: start-up time
     from shipblock.processing import process_motion
     from shipblock.scaling import measure_value, scale_record
 
