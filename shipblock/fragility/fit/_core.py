@@ -1,4 +1,12 @@
-"""Common parts of the fragility fits: the fitted curve, its errors and checks."""
+r"""Common parts of the fragility fits: the fitted lognormal curve and its checks.
+
+:class:`FragilityFit` holds a fitted curve
+:math:`P(\mathrm{LS} \mid \mathrm{IM} = x) = \Phi(\ln(x/\theta)/\beta)` (see
+:mod:`shipblock.fragility.fit`), :func:`lognormal_fragility` evaluates it, and
+:class:`FragilityFitError` says that data cannot identify one. Used by every estimator
+(:mod:`~shipblock.fragility.fit.msa`, :mod:`~shipblock.fragility.fit.ida`,
+:mod:`~shipblock.fragility.fit.cloud`) and by the bootstrap.
+"""
 
 from __future__ import annotations
 

@@ -1,4 +1,10 @@
-"""Bootstrap over records."""
+"""Bootstrap over records: confidence bands of a fragility fit.
+
+:func:`bootstrap` resamples the records with replacement, refits each resample with the same
+estimator and takes percentiles of the medians, dispersions and curves. Each resample has its
+own seed (``numpy.random.SeedSequence.spawn``), so the result does not depend on where the
+resamples run (:class:`~shipblock.fragility.workers.Workers`: here, local processes or Dask).
+"""
 
 from __future__ import annotations
 

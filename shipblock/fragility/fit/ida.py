@@ -1,4 +1,11 @@
-"""Incremental dynamic analysis: capacities and their fits."""
+"""Incremental dynamic analysis: each record's capacity and the fits to the capacities.
+
+:func:`ida_capacities` turns a record x level exceedance matrix into capacity bounds (the last
+level that held, the first that failed); :func:`fit_ida_levels` fits them, by default as
+intervals (:func:`fit_ida_intervals`, interval-censored maximum likelihood), and
+:func:`fit_ida` fits capacities known exactly (moments or right-censored maximum likelihood).
+References in :mod:`shipblock.fragility.fit`.
+"""
 
 from __future__ import annotations
 
