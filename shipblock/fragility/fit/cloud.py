@@ -1,4 +1,4 @@
-"""Cloud analysis of unscaled records.
+r"""Cloud analysis of unscaled records.
 
 :func:`fit_cloud` regresses :math:`\ln \mathrm{EDP}` on :math:`\ln \mathrm{IM}` (Cornell et
 al. 2002, Jalayer 2003) or fits a probit to the binary outcome. References in

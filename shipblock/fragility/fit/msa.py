@@ -1,4 +1,4 @@
-"""Multiple-stripe analysis: the binomial maximum-likelihood fit (Baker 2015).
+r"""Multiple-stripe analysis: the binomial maximum-likelihood fit (Baker 2015).
 
 At each IM level :math:`x_j` of :math:`n_j` runs, :math:`z_j` exceed the limit state;
 :func:`fit_mle` maximises the binomial likelihood of the counts, :func:`fit_msa` does the same
