@@ -8,7 +8,7 @@ The work of a design is done in three steps:
 2. :func:`run_batch` splits the case numbers into chunks (:meth:`AnalysisDesign.chunks`) and
    runs every chunk not yet on disk with :func:`run_chunk`, either here (one call of the
    model's batch entry point per chunk, :meth:`Model.run_batch
-   <shipblock.models.Model.run_batch>`: for the rigid model one
+   <shipblock.models.base.Model.run_batch>`: for the rigid model one
    :func:`shipblock.simulate_batch` call, numba threads over all cores) or as Dask
    tasks when a ``distributed.Client`` is given. Each finished chunk is written at once to a
    :class:`~shipblock.fragility.store.ChunkStore`, so a killed batch resumes where it stopped.
@@ -271,7 +271,7 @@ def run_batch(
     -------
     dict of numpy.ndarray
         One array of length ``design.n_cases`` per name of
-        the model's outputs (:attr:`Model.outputs <shipblock.models.Model.outputs>`; for the
+        the model's outputs (:attr:`Model.outputs <shipblock.models.base.Model.outputs>`; for the
         rigid model :data:`~shipblock.fragility.store.RUN_VARIABLES`; NaN for runs without a
         result) and
         ``run_error`` (strings, empty for good runs).

@@ -3,7 +3,7 @@
 :func:`run_chunk` is what a chunk task does, here or on a Dask worker
 (:func:`shipblock.fragility.workers.run_chunk_task`); :func:`mark_solver_errors` turns the runs
 the model's solver gave up on into missing results. Both know the model only through
-:class:`shipblock.models.Model`.
+:class:`shipblock.models.base.Model`.
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ def run_chunk(records, systems, cases, *, model: Model | None = None, **options)
     Returns
     -------
     dict of numpy.ndarray
-        :meth:`Model.run_batch <shipblock.models.Model.run_batch>`'s outputs, one value per
+        :meth:`Model.run_batch <shipblock.models.base.Model.run_batch>`'s outputs, one value per
         case.
     """
     model = get_model(DEFAULT_MODEL) if model is None else model
@@ -70,7 +70,7 @@ def mark_solver_errors(out: dict, model: Model) -> np.ndarray:
     out : dict of numpy.ndarray
         Float outputs of :func:`run_chunk` (changed in place).
     model : shipblock.models.Model
-        Its :attr:`~shipblock.models.Model.solver_error_code` marks the failed runs.
+        Its :attr:`~shipblock.models.base.Model.solver_error_code` marks the failed runs.
 
     Returns
     -------

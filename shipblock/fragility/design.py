@@ -14,10 +14,10 @@ contiguous range of case numbers (:meth:`AnalysisDesign.chunks`), the unit of wo
 to :func:`shipblock.simulate_batch`, written to disk when done and never recomputed.
 
 Swept parameters are those of the study's model
-(:attr:`Model.sweep_parameters <shipblock.models.Model.sweep_parameters>`; for the rigid model
+(:attr:`Model.sweep_parameters <shipblock.models.base.Model.sweep_parameters>`; for the rigid model
 any field of :class:`shipblock.ShipBlockSystem` plus the conveniences ``slenderness``,
 ``mass_ratio``, ``mu_ground`` and ``mu_ship`` of :mod:`shipblock.models.rigid`). The design
-changes a system only through :meth:`Model.vary <shipblock.models.Model.vary>`.
+changes a system only through :meth:`Model.vary <shipblock.models.base.Model.vary>`.
 """
 
 from __future__ import annotations
@@ -200,7 +200,7 @@ class IntensityDesign:
         Raises
         ------
         shipblock.models.FieldError
-            With the offending field as :attr:`~shipblock.models.FieldError.field` (``type``,
+            With the offending field as :attr:`~shipblock.models.base.FieldError.field` (``type``,
             ``measure``, ``period``, ``damping``, ``vertical``, ``levels``,
             ``vertical_levels``): an unknown type, measure or vertical mode, a period or
             damping out of range, a level that is not a number within
@@ -457,7 +457,7 @@ class AnalysisDesign:
         Returns
         -------
         object
-            The model's system (:meth:`Model.vary <shipblock.models.Model.vary>`).
+            The model's system (:meth:`Model.vary <shipblock.models.base.Model.vary>`).
 
         Raises
         ------

@@ -239,7 +239,7 @@ def run_case(design: AnalysisDesign, records, case: int, solver_options: Mapping
     Returns
     -------
     shipblock.SimulationResult
-        :meth:`Model.simulate <shipblock.models.Model.simulate>` of the design's model (a
+        :meth:`Model.simulate <shipblock.models.base.Model.simulate>` of the design's model (a
         :class:`~shipblock.SimulationResult` for the rigid model): equal bit for bit, in every
         summary value, to the batch's run of the case.
 

@@ -1,7 +1,7 @@
 """The keys of a pipeline file, each declared once.
 
 Every key of a pipeline file (:mod:`shipblock.fragility.schema`) is a
-:class:`~shipblock.models.Field` here: name, type, unit, range or choices, default and a
+:class:`~shipblock.models.base.Field` here: name, type, unit, range or choices, default and a
 one-line doc. From these declarations alone
 
 * the file's tables are checked (:func:`check_table`: unknown keys, types, required keys) and
@@ -12,9 +12,9 @@ one-line doc. From these declarations alone
   ``pipeline-keys`` directive of ``docs/conf.py`` at every build).
 
 The ``[system]`` and ``[solver]`` tables belong to the study's model
-(:attr:`Model.parameters <shipblock.models.Model.parameters>`,
-:attr:`Model.options <shipblock.models.Model.options>`; ``[system] model`` names it) and
-``[sweep]`` takes the model's :attr:`~shipblock.models.Model.sweep_parameters`: a new model
+(:attr:`Model.parameters <shipblock.models.base.Model.parameters>`,
+:attr:`Model.options <shipblock.models.base.Model.options>`; ``[system] model`` names it) and
+``[sweep]`` takes the model's :attr:`~shipblock.models.base.Model.sweep_parameters`: a new model
 brings its own keys, with nothing to add here.
 
 Adding a key: declare it in :data:`SECTIONS` (in the order the docs list it), read it in
@@ -114,7 +114,7 @@ class PipelineError(ShipblockError, ValueError):
 
     @property
     def field(self) -> str:
-        """str: The key (as :attr:`shipblock.models.FieldError.field`)."""
+        """str: The key (as :attr:`shipblock.models.base.FieldError.field`)."""
         return self.key
 
     def __reduce__(self):

@@ -116,7 +116,7 @@ class LimitState:
         Parameters
         ----------
         model : shipblock.models.Model, optional
-            The model whose EDPs (:attr:`~shipblock.models.Model.edps`) and failure codes the
+            The model whose EDPs (:attr:`~shipblock.models.base.Model.edps`) and failure codes the
             limit state refers to (default: the rigid model, :data:`EDP_VARIABLES`).
 
         Returns

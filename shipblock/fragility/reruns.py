@@ -3,7 +3,7 @@ a pipeline asks for.
 
 :func:`rerun_case` reads and processes the case's record as the pipeline does and runs the
 case on the same input, system and solver options as the batch did, through the study's model
-(:meth:`Model.simulate <shipblock.models.Model.simulate>`), so that its summary equals the
+(:meth:`Model.simulate <shipblock.models.base.Model.simulate>`), so that its summary equals the
 batch's bit for bit. :func:`add_histories` does the same for the runs of a ``[histories]``
 request, after the batch. :func:`record_loader` and :func:`match_target_spectrum` are the
 record preparation both share with :func:`~shipblock.fragility.pipeline.run_pipeline`.
@@ -138,7 +138,7 @@ def rerun_case(path, record: str, *, im_level=None, im_level_g=None, **sweep):
     Returns
     -------
     shipblock.SimulationResult
-        The model's result (:meth:`Model.simulate <shipblock.models.Model.simulate>`).
+        The model's result (:meth:`Model.simulate <shipblock.models.base.Model.simulate>`).
 
     Raises
     ------

@@ -442,7 +442,7 @@ def _check_chain(chain, source):
 
 def _system(table: Mapping, model: Model, source: str):
     """The model's system from ``[system]``: each value by its declaration, then the model's
-    own checks (:meth:`Model.build <shipblock.models.Model.build>`)."""
+    own checks (:meth:`Model.build <shipblock.models.base.Model.build>`)."""
     params = {k: v for k, v in table.items() if k != "model"}
     for key in params:
         value(params, "system", key, source, model)

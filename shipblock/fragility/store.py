@@ -19,7 +19,7 @@ next run removes those of its own files (:func:`remove_stale_temporaries`,
 :meth:`ChunkStore.open`), never anything else.
 
 Every variable and coordinate of a result dataset carries ``units`` and ``long_name``;
-:attr:`Model.outputs <shipblock.models.Model.outputs>` lists those of the per-run summaries
+:attr:`Model.outputs <shipblock.models.base.Model.outputs>` lists those of the per-run summaries
 (:data:`RUN_VARIABLES` those of the rigid model).
 """
 
