@@ -149,6 +149,26 @@ class CommandHelp(SphinxDirective):
         return [node]
 
 
+class PipelineKeys(SphinxDirective):
+    """``.. pipeline-keys:: [model]``: the table of every pipeline key, at build time.
+
+    Written by :func:`shipblock.fragility.keys.key_table` from the keys' declarations (those of
+    ``[system]``, ``[solver]`` and ``[sweep]`` from the model named, default ``rigid``), so the
+    page lists exactly what the parser accepts, with its type, unit, range and default.
+    """
+
+    optional_arguments = 1
+
+    def run(self):
+        from shipblock.fragility.keys import key_table
+
+        text = key_table(self.arguments[0] if self.arguments else None)
+        container = nodes.container()
+        self.state.nested_parse(StringList(text.splitlines(), source="<pipeline-keys>"),
+                                self.content_offset, container)
+        return container.children
+
+
 class OptionalTocTree(TocTree):
     """``.. optional-toctree::``: a toctree that leaves out entries with no source file.
 
@@ -168,4 +188,5 @@ def setup(app):
     os.environ["COLUMNS"] = "96"  # argparse wraps help text to this width
     app.connect("autodoc-process-docstring", _fix_docstrings)
     app.add_directive("shipblock-help", CommandHelp)
+    app.add_directive("pipeline-keys", PipelineKeys)
     app.add_directive("optional-toctree", OptionalTocTree)

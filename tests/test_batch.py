@@ -15,6 +15,7 @@ import pytest
 
 from shipblock import ShipBlockSystem, intensity, simulate
 from shipblock.fragility import batch as batch_mod
+from shipblock.models import rigid as rigid_mod
 from shipblock.fragility.batch import prepare_record, run_batch, run_chunk, summary_dataset
 from shipblock.fragility.design import AnalysisDesign, IntensityDesign, apply_parameters
 from shipblock.fragility.store import ChunkStore
@@ -230,7 +231,7 @@ def test_run_chunk_equals_single_simulate_bit_for_bit():
 def test_solver_errors_become_nan_with_message():
     out = {"failure": np.array([0.0, 3.0, 2.0]), "failure_time": np.array([np.nan, 1.25, 2.0]),
            "peak_ship_slip": np.array([0.1, 0.2, 0.3])}
-    msg = batch_mod._mark_solver_errors(out)
+    msg = batch_mod.mark_solver_errors(out, rigid_mod.RigidModel())
     assert list(msg) == ["", "solver error (failure code 3) at t = 1.25 s", ""]
     assert np.isnan(out["peak_ship_slip"][1]) and np.isnan(out["failure"][1])
     assert out["failure"][2] == 2.0
@@ -299,13 +300,13 @@ def test_run_chunk_converts_only_the_systems_its_cases_use(monkeypatch):
     systems = [SYSTEM.replace(mu_s_ship=0.3 + 0.01 * k, mu_k_ship=0.3) for k in range(40)]
     cases = np.array([[0, 1, 7], [1, 0, 31], [0, 1, 31]])
     seen = []
-    real = batch_mod.simulate_batch
+    real = rigid_mod.simulate_batch  # the rigid model's batch entry point
 
     def spy(systems_, *args, **kwargs):
         seen.append(list(systems_))
         return real(systems_, *args, **kwargs)
 
-    monkeypatch.setattr(batch_mod, "simulate_batch", spy)
+    monkeypatch.setattr(rigid_mod, "simulate_batch", spy)
     out = run_chunk([r.payload() for r in recs], systems, cases)
     assert seen == [[systems[7], systems[31]]]
     ref = run_chunk([r.payload() for r in recs], [systems[7], systems[31]],

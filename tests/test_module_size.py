@@ -19,12 +19,11 @@ EXEMPT = {"solver/_kernel.py"}
 
 #: Modules above the limit today, and what splits them.
 OVER_THE_LIMIT = {
-    "fragility/pipeline.py": "issue 28: split into schema, study run and fitting step",
-    "fragility/fit.py": "issue 28: split into estimators, bootstrap and checkpointing",
     "solver/_closed_form.py": "the solver's closed-form spans (813 lines)",
     "intensity.py": "the intensity measures and the response spectrum (815 lines)",
     "processing.py": "the processing chain and its steps (805 lines)",
     "io/dmg.py": "the CSMIP/CDMG reader (852 lines)",
+    "cli.py": "the command line: one module per group of sub-commands once the wave's merges land",
 }
 
 ROOT = Path(shipblock.__file__).resolve().parent

@@ -676,13 +676,14 @@ def test_resume_after_sigkill_gives_same_result(tmp_path, monkeypatch):
 _SLOW_FITS = textwrap.dedent(
     """
     import sys, time
-    from shipblock.fragility import pipeline
-    pipeline.FIT_CHECKPOINT_INTERVAL = 0.0   # every fit written as soon as it is done
-    real = pipeline._fit_one
+    from shipblock.fragility import fit_step, pipeline
+    from shipblock.fragility.fit import checkpoint
+    checkpoint.FIT_CHECKPOINT_INTERVAL = 0.0   # every fit written as soon as it is done
+    real = fit_step._fit_one
     def slow(*args, **kwargs):
         time.sleep(0.4)   # make fits slow enough to be killed among them
         return real(*args, **kwargs)
-    pipeline._fit_one = slow
+    fit_step._fit_one = slow
     pipeline.run_pipeline(sys.argv[1], output=sys.argv[2], progress=False)
     """
 )
@@ -707,12 +708,12 @@ def test_resume_after_sigkill_during_the_fits_gives_same_result(tmp_path, monkey
     assert 3 <= done < 8
 
     from shipblock.fragility import batch
-    from shipblock.fragility import pipeline as pipeline_mod
+    from shipblock.fragility import fit_step as fit_step_mod
 
     monkeypatch.setattr(batch, "run_chunk", lambda *a, **k: pytest.fail("the batch ran again"))
     calls = []
-    real = pipeline_mod._fit_one
-    monkeypatch.setattr(pipeline_mod, "_fit_one",
+    real = fit_step_mod._fit_one
+    monkeypatch.setattr(fit_step_mod, "_fit_one",
                         lambda *a, **k: (calls.append(1), real(*a, **k))[1])
     resumed = run_pipeline(path, output=out, progress=False)
     assert len(calls) == 8 - done  # finished fits were not made again

@@ -79,14 +79,10 @@ from shipblock.fragility.histories import (  # noqa: E402
     select_cases,
     write_histories,
 )
-from shipblock.fragility.pipeline import (  # noqa: E402
-    HistoryRequest,
-    PipelineError,
-    load_pipeline,
-    parse_pipeline,
-    rerun_case,
-    run_pipeline,
-)
+from shipblock.fragility.keys import PipelineError  # noqa: E402
+from shipblock.fragility.pipeline import run_pipeline  # noqa: E402
+from shipblock.fragility.reruns import rerun_case  # noqa: E402
+from shipblock.fragility.schema import HistoryRequest, load_pipeline, parse_pipeline  # noqa: E402
 
 __all__ += ["HistoryRequest", "PipelineError", "SelectionError", "case_number", "load_pipeline",
             "parse_pipeline", "rerun_case", "run_case", "run_pipeline", "select_cases",

@@ -6,8 +6,10 @@ The work of a design is done in three steps:
    factors at every IM level (:func:`shipblock.scaling.scale_record`). A record that cannot be
    read, processed or scaled keeps its error message and takes no part in the runs.
 2. :func:`run_batch` splits the case numbers into chunks (:meth:`AnalysisDesign.chunks`) and
-   runs every chunk not yet on disk with :func:`run_chunk`, either here (one
-   :func:`shipblock.simulate_batch` call per chunk, numba threads over all cores) or as Dask
+   runs every chunk not yet on disk with :func:`run_chunk`, either here (one call of the
+   model's batch entry point per chunk, :meth:`Model.run_batch
+   <shipblock.models.base.Model.run_batch>`: for the rigid model one
+   :func:`shipblock.simulate_batch` call, numba threads over all cores) or as Dask
    tasks when a ``distributed.Client`` is given. Each finished chunk is written at once to a
    :class:`~shipblock.fragility.store.ChunkStore`, so a killed batch resumes where it stopped.
 3. :func:`summary_dataset` arranges the per-case results on the design's dimensions.
@@ -31,18 +33,14 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
+from shipblock.fragility.chunk import mark_solver_errors, run_chunk
 from shipblock.fragility.design import AnalysisDesign, IntensityDesign
-from shipblock.fragility.store import RUN_VARIABLES, ChunkStore, StoreError
-from shipblock.modes import Failure
-from shipblock.solver import (
-    DEFAULT_ATOL,
-    DEFAULT_RTOL,
-    DEFAULT_ZENO_OMEGA,
-    simulate_batch,
-)
+from shipblock.fragility.store import ChunkStore, StoreError
+from shipblock.fragility.workers import host_task_threads, run_chunk_task
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
+    "mark_solver_errors",
     "PreparedRecord",
     "prepare_record",
     "run_batch",
@@ -147,7 +145,7 @@ def prepare_record(
     record_id : str
         Record id (used in messages).
     load : callable
-        Returns the :class:`shipblock.motion.GroundMotion` (e.g. ``entry.read``).
+        Returns the :class:`shipblock.records.motion.GroundMotion` (e.g. ``entry.read``).
     chain : iterable of mapping or None
         Processing chain (:func:`shipblock.processing.apply_chain`); None for the default
         chain, ``[]`` for none.
@@ -161,6 +159,7 @@ def prepare_record(
         level needs a scaled record above :data:`shipblock.checks.MAX_ACCELERATION`, 100 g,
         which :func:`~shipblock.scaling.scale_record` refuses).
     """
+    # the processing stack (obspy) loads when the first record is prepared: start-up time
     from shipblock.processing import process_motion
     from shipblock.scaling import measure_value, scale_record
 
@@ -193,74 +192,8 @@ def prepare_record(
 
 
 # --------------------------------------------------------------------------------------------
-# one chunk
-# --------------------------------------------------------------------------------------------
-
-
-def run_chunk(records, systems, cases, *, rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL,
-              zeno_omega=DEFAULT_ZENO_OMEGA) -> dict:
-    """Run the cases of one chunk with one :func:`shipblock.simulate_batch` call.
-
-    Pure: the output depends only on the arguments (safe as a Dask task).
-
-    Parameters
-    ----------
-    records : sequence of tuple
-        ``(h, v, dt, factor_h, factor_v)`` per record (see :meth:`PreparedRecord.payload`):
-        accelerations [m/s^2], sampling interval [s], factors per level [-].
-    systems : sequence of ShipBlockSystem
-        The systems the cases refer to.
-    cases : array_like of int, shape (n, 3)
-        ``(record index into records, level index, system index)`` per case.
-    rtol, atol, zeno_omega : float
-        Solver tolerances (see :func:`shipblock.simulate`).
-
-    Returns
-    -------
-    dict of numpy.ndarray
-        The summary arrays of :func:`~shipblock.simulate_batch`, one value per case.
-    """
-    cases = np.asarray(cases, dtype=np.int64).reshape(-1, 3)
-    # each (record, level) pair is scaled once and each system converted once, and only those
-    # the chunk uses: the cost of a chunk does not grow with the size of the whole design
-    n_levels = int(cases[:, 1].max(initial=0)) + 1
-    pairs, pair_of_case = np.unique(cases[:, 0] * n_levels + cases[:, 1], return_inverse=True)
-    used, system_of_case = np.unique(cases[:, 2], return_inverse=True)
-    inputs, dts = [], []
-    for pair in pairs.tolist():
-        r, j = divmod(pair, n_levels)
-        h, v, dt, fh, fv = records[r]
-        f_v = fv[j]
-        vertical = None if v is None or not np.isfinite(f_v) or f_v == 0.0 else f_v * v
-        inputs.append((fh[j] * h, vertical))
-        dts.append(dt)
-    ones = np.ones(len(cases))
-    batch = np.column_stack([pair_of_case.ravel(), system_of_case.ravel(), ones, ones])
-    return simulate_batch([systems[i] for i in used.tolist()], inputs, dts, batch, rtol=rtol,
-                          atol=atol, zeno_omega=zeno_omega)
-
-
-def _mark_solver_errors(out: dict) -> np.ndarray:
-    """Turn runs with failure code 3 into NaN results and return their error messages."""
-    failure = out["failure"]
-    messages = np.full(failure.shape, "", dtype="U80")
-    bad = failure == int(Failure.SOLVER_ERROR)
-    if not bad.any():
-        return messages
-    for i in np.flatnonzero(bad):
-        messages[i] = (f"solver error (failure code {int(Failure.SOLVER_ERROR)}) at "
-                       f"t = {out['failure_time'][i]:.6g} s")
-    for name in out:
-        out[name] = np.where(bad, np.nan, out[name])
-    return messages
-
-
-# --------------------------------------------------------------------------------------------
 # the batch
 # --------------------------------------------------------------------------------------------
-
-_NAMES = tuple(RUN_VARIABLES)
-
 
 class _Task:
     """What one chunk needs: its cases, the runnable ones and their local indices."""
@@ -275,23 +208,24 @@ class _Task:
         self.records, local = np.unique(idx[:, 0], return_inverse=True)
         self.local_cases = np.column_stack([local.ravel(), idx[:, 1], idx[:, 2]])
 
-    def assemble(self, out: dict | None) -> tuple[np.ndarray, np.ndarray]:
-        """Full-chunk results (NaN for cases of failed records) from the solver output.
+    def assemble(self, out: dict | None, model) -> tuple[np.ndarray, np.ndarray]:
+        """Full-chunk results (NaN for cases of failed records) from the model's output.
 
         Returns
         -------
-        values : numpy.ndarray, shape (len(RUN_VARIABLES), n)
-            One row per run variable, in the order of ``RUN_VARIABLES``.
+        values : numpy.ndarray, shape (len(model.outputs), n)
+            One row per run variable, in the order of ``model.outputs``.
         errors : numpy.ndarray of str, shape (n,)
             ``run_error`` of each case.
         """
+        names = tuple(model.outputs)
         n = self.cases.size
-        values = np.full((len(_NAMES), n), np.nan)
+        values = np.full((len(names), n), np.nan)
         errors = np.full(n, "", dtype="U80")
         if out is not None:
-            out = {name: np.asarray(out[name], dtype=float) for name in _NAMES}
-            msg = _mark_solver_errors(out)
-            values[:, self.runnable] = np.stack([out[name] for name in _NAMES])
+            out = {name: np.asarray(out[name], dtype=float) for name in names}
+            msg = mark_solver_errors(out, model)
+            values[:, self.runnable] = np.stack([out[name] for name in names])
             errors[self.runnable] = msg
         return values, errors
 
@@ -337,17 +271,21 @@ def run_batch(
     -------
     dict of numpy.ndarray
         One array of length ``design.n_cases`` per name of
-        :data:`~shipblock.fragility.store.RUN_VARIABLES` (NaN for runs without a result) and
+        the model's outputs (:attr:`Model.outputs <shipblock.models.base.Model.outputs>`; for the
+        rigid model :data:`~shipblock.fragility.store.RUN_VARIABLES`; NaN for runs without a
+        result) and
         ``run_error`` (strings, empty for good runs).
     """
     from tqdm.auto import tqdm
 
     opts = dict(solver_options or {})
+    model = design.model
+    names = tuple(model.outputs)
     systems = design.systems()
     chunks = design.chunks(chunk_size)
     n = design.n_cases
     # one row per run variable: filled a chunk at a time, returned as row views
-    table = np.full((len(_NAMES), n), np.nan)
+    table = np.full((len(names), n), np.nan)
     run_error = np.full(n, "", dtype=object)
 
     def fill(chunk: range, values: np.ndarray, errors: np.ndarray):
@@ -362,7 +300,7 @@ def run_batch(
         if k in available:
             try:
                 cases, arrays = store.read(k)
-                values = np.stack([np.asarray(arrays[name], dtype=float) for name in _NAMES])
+                values = np.stack([np.asarray(arrays[name], dtype=float) for name in names])
                 errors = np.asarray(arrays["run_error"], dtype=str)
             except (StoreError, KeyError, ValueError) as exc:
                 logger.warning("chunk %d unusable (%s); recomputing it", k, exc)
@@ -386,8 +324,8 @@ def run_batch(
 
         def finish(k: int, out):
             task = tasks.pop(k)
-            values, errors = task.assemble(out)
-            store.write(k, task.cases, {**dict(zip(_NAMES, values, strict=True)),
+            values, errors = task.assemble(out, model)
+            store.write(k, task.cases, {**dict(zip(names, values, strict=True)),
                                         "run_error": errors})
             fill(task.chunk, values, errors)
             bar.update(len(task.chunk))
@@ -401,15 +339,15 @@ def run_batch(
                 t = tasks[k]
                 payload = [records[r].payload() for r in t.records]
                 t0 = time.perf_counter()
-                out = run_chunk(payload, systems, t.local_cases, **opts)
+                out = run_chunk(payload, systems, t.local_cases, model=model, **opts)
                 if timings is not None:
                     timings["solver"] = timings.get("solver", 0.0) + time.perf_counter() - t0
                 finish(k, out)
         else:
-            _run_dask(client, records, systems, tasks, runnable, opts, finish)
+            _run_dask(client, records, systems, tasks, runnable, {"model": model, **opts}, finish)
     finally:
         bar.close()
-    results = dict(zip(_NAMES, table, strict=True))
+    results = dict(zip(names, table, strict=True))
     results["run_error"] = run_error
     return results
 
@@ -420,9 +358,7 @@ def _run_dask(client, records, systems, tasks, runnable, opts, finish):
     Each task runs on its share of its host's cores (numba threads:
     :func:`~shipblock.fragility.workers.run_chunk_task`).
     """
-    from distributed import as_completed
-
-    from shipblock.fragility.workers import host_task_threads, run_chunk_task
+    from distributed import as_completed  # optional dependency: only with a client
 
     hosts = host_task_threads(client)
 
@@ -463,7 +399,8 @@ def summary_dataset(design: AnalysisDesign, records: list[PreparedRecord],
     Returns
     -------
     xarray.Dataset
-        Per-run variables of :data:`~shipblock.fragility.store.RUN_VARIABLES` and
+        Per-run variables of the model's outputs (rigid model:
+        :data:`~shipblock.fragility.store.RUN_VARIABLES`) and
         ``run_error`` on ``design.dims``; per record and level ``scale_factor``,
         ``vertical_scale_factor``, ``achieved_im``, ``achieved_im_vertical`` (and
         ``in_stripe`` for a design with per-level record sets); per record
@@ -480,7 +417,7 @@ def summary_dataset(design: AnalysisDesign, records: list[PreparedRecord],
         return arr[:, 0] if cloud else arr
 
     data = {}
-    for name, (units, long_name) in RUN_VARIABLES.items():
+    for name, (units, long_name) in design.model.outputs.items():
         data[name] = (dims, grid(results[name]), {"units": units, "long_name": long_name})
     data["run_error"] = (
         dims, grid(np.asarray(results["run_error"], dtype=object)),

@@ -13,33 +13,26 @@ Every run (a *case*) is one point of that grid. Cases are numbered in C order ov
 contiguous range of case numbers (:meth:`AnalysisDesign.chunks`), the unit of work that is sent
 to :func:`shipblock.simulate_batch`, written to disk when done and never recomputed.
 
-Swept parameters are any field of :class:`shipblock.ShipBlockSystem` plus four conveniences:
-
-``slenderness``
-    :math:`B/H` [-]; ``half_height`` is kept and ``half_width = slenderness * half_height``.
-``mass_ratio``
-    :math:`nm/M` [-]; ``ship_mass`` and ``n_blocks`` are kept and
-    ``block_mass = mass_ratio * ship_mass / n_blocks``.
-``mu_ground``, ``mu_ship``
-    The static friction coefficient of an interface [-]; the kinetic one keeps its ratio to the
-    static one in the base system (``mu_k = mu * mu_k_base / mu_s_base``), so a sweep never
-    produces kinetic friction above static friction.
-
-Conveniences are applied after the plain fields, so ``half_height`` and ``slenderness`` may be
-swept together (the width follows the height).
+Swept parameters are those of the study's model
+(:attr:`Model.sweep_parameters <shipblock.models.base.Model.sweep_parameters>`; for the rigid model
+any field of :class:`shipblock.ShipBlockSystem` plus the conveniences ``slenderness``,
+``mass_ratio``, ``mu_ground`` and ``mu_ship`` of :mod:`shipblock.models.rigid`). The design
+changes a system only through :meth:`Model.vary <shipblock.models.base.Model.vary>`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, fields
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from shipblock.checks import MAX_PERIOD, MIN_PERIOD, choice, real, whole
+from shipblock.checks import MAX_PERIOD, MIN_PERIOD, choice, real
 from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.intensity import DEFAULT_DAMPING
-from shipblock.system import FIELD_LIMITS, ShipBlockSystem
+from shipblock.models import DEFAULT_MODEL, FieldError, Model, get_model
+from shipblock.models.rigid import SWEEP_PARAMETERS, SYSTEM_FIELDS, apply_parameters
 from shipblock.units import STANDARD_GRAVITY
 
 __all__ = [
@@ -70,27 +63,6 @@ IM_MEASURES: Mapping[str, tuple[str, str]] = {
 #: the horizontal factor (keeps V/H), scaled to its own levels, left unscaled, or dropped.
 VERTICAL_MODES = ("same", "independent", "unscaled", "zero")
 
-#: Parameters that may be swept: name -> (units, long name). The plain names are fields of
-#: :class:`~shipblock.ShipBlockSystem`; see the module docstring for the conveniences.
-SWEEP_PARAMETERS: Mapping[str, tuple[str, str]] = {
-    "ship_mass": ("kg", "ship mass M"),
-    "block_mass": ("kg", "mass of one keel block m"),
-    "n_blocks": ("1", "number of keel blocks n"),
-    "half_width": ("m", "block half width B"),
-    "half_height": ("m", "block half height H"),
-    "mu_s_ground": ("1", "static friction coefficient, blocks on ground"),
-    "mu_k_ground": ("1", "kinetic friction coefficient, blocks on ground"),
-    "mu_s_ship": ("1", "static friction coefficient, ship on blocks"),
-    "mu_k_ship": ("1", "kinetic friction coefficient, ship on blocks"),
-    "restitution": ("1", "coefficient of restitution of rocking impacts"),
-    "block_inertia": ("kg m^2", "centroidal inertia of one block I"),
-    "g": ("m/s^2", "acceleration of gravity"),
-    "slenderness": ("1", "block slenderness B/H (half width over half height)"),
-    "mass_ratio": ("1", "total block mass over ship mass nm/M"),
-    "mu_ground": ("1", "static friction coefficient blocks-ground (kinetic/static ratio kept)"),
-    "mu_ship": ("1", "static friction coefficient ship-blocks (kinetic/static ratio kept)"),
-}
-
 #: Accepted range of IM levels per measure [SI units of the measure]: PGA and Sa 0.001 g to
 #: 10 g, PGV 1 mm/s to 10 m/s. Outside it a level is a unit mistake (1e6 g) or no motion at
 #: all, and scaling a record to it would give an implausible ground motion.
@@ -100,13 +72,22 @@ IM_LEVEL_RANGE: Mapping[str, tuple[float, float]] = {
     "sa": (1e-3 * STANDARD_GRAVITY, 10.0 * STANDARD_GRAVITY),
 }
 
-_CONVENIENCES = ("slenderness", "mass_ratio", "mu_ground", "mu_ship")
-_CONFLICTS = {
-    "slenderness": ("half_width",),
-    "mass_ratio": ("block_mass",),
-    "mu_ground": ("mu_s_ground", "mu_k_ground"),
-    "mu_ship": ("mu_s_ship", "mu_k_ship"),
-}
+@contextmanager
+def _field(name: str):
+    """Re-raise a ParameterError of the block as a FieldError naming ``name`` (same text)."""
+    try:
+        yield
+    except FieldError:
+        raise
+    except ParameterError as exc:
+        error = FieldError(name, str(exc))
+        if isinstance(exc, ParameterTypeError):
+            error = _FieldTypeError(name, str(exc))
+        raise error from None
+
+
+class _FieldTypeError(FieldError, ParameterTypeError):
+    """A FieldError that is also a ParameterTypeError (a value of the wrong type)."""
 
 
 def check_levels(values, name: str, measure: str) -> np.ndarray:
@@ -145,63 +126,6 @@ def check_levels(values, name: str, measure: str) -> np.ndarray:
                                  f"{low:g} .. {high:g} {units}{in_g} of {measure.upper()} levels")
         out.append(x)
     return np.array(out, dtype=float)
-
-
-def apply_parameters(system: ShipBlockSystem, values: Mapping[str, object]) -> ShipBlockSystem:
-    """Return ``system`` with some parameters (plain fields or conveniences) changed.
-
-    Parameters
-    ----------
-    system : ShipBlockSystem
-        The base system.
-    values : Mapping[str, object]
-        Parameter name (a key of :data:`SWEEP_PARAMETERS`) -> value, in the units listed there.
-
-    Returns
-    -------
-    ShipBlockSystem
-        The changed, validated system.
-
-    Raises
-    ------
-    ValueError
-        If a name is unknown, two names set the same field (e.g. ``slenderness`` and
-        ``half_width``), or the resulting system is invalid (the message of
-        :class:`~shipblock.ShipBlockSystem` names the field).
-    """
-    unknown = [k for k in values if k not in SWEEP_PARAMETERS]
-    if unknown:
-        raise ParameterError(
-            f"unknown system parameter(s) {', '.join(map(repr, unknown))}; known: "
-            f"{', '.join(SWEEP_PARAMETERS)}"
-        )
-    for conv, plain in _CONFLICTS.items():
-        clash = [p for p in plain if conv in values and p in values]
-        if clash:
-            raise ParameterError(f"{conv!r} and {clash[0]!r} both set the same parameter; give one")
-    plain = {k: v for k, v in values.items() if k not in _CONVENIENCES}
-    if "n_blocks" in plain:
-        plain["n_blocks"] = _whole(plain["n_blocks"], "n_blocks")
-    out = system.replace(**plain) if plain else system
-    changes = {}
-    if "slenderness" in values:
-        changes["half_width"] = float(values["slenderness"]) * out.half_height
-    if "mass_ratio" in values:
-        changes["block_mass"] = float(values["mass_ratio"]) * out.ship_mass / out.n_blocks
-    for iface in ("ground", "ship"):
-        key = f"mu_{iface}"
-        if key in values:
-            mu = float(values[key])
-            mus, muk = getattr(system, f"mu_s_{iface}"), getattr(system, f"mu_k_{iface}")
-            ratio = muk / mus if mus > 0 else 1.0
-            changes[f"mu_s_{iface}"] = mu
-            changes[f"mu_k_{iface}"] = mu * ratio
-    return out.replace(**changes) if changes else out
-
-
-def _whole(value, name):
-    low, high, _ = FIELD_LIMITS[name]
-    return whole(value, name, low=low, high=high)
 
 
 @dataclass(frozen=True)
@@ -275,41 +199,54 @@ class IntensityDesign:
 
         Raises
         ------
-        ParameterError
-            Naming the offending field (its message starts with the field's name): an unknown
-            type, measure or vertical mode, a period or damping out of range, a level that is
-            not a number within :data:`IM_LEVEL_RANGE`, levels not strictly increasing.
+        shipblock.models.FieldError
+            With the offending field as :attr:`~shipblock.models.base.FieldError.field` (``type``,
+            ``measure``, ``period``, ``damping``, ``vertical``, ``levels``,
+            ``vertical_levels``): an unknown type, measure or vertical mode, a period or
+            damping out of range, a level that is not a number within
+            :data:`IM_LEVEL_RANGE`, levels not strictly increasing. A
+            :class:`~shipblock.errors.ParameterError` (a ``ParameterTypeError`` for a wrong
+            type).
         """
-        choice(self.kind, "type", DESIGN_TYPES)
-        choice(self.measure, "measure", tuple(IM_MEASURES))
-        if self.measure == "sa":
-            if self.period is None:
-                raise ParameterError("period [s] is required for measure 'sa'")
-            real(self.period, "period", low=MIN_PERIOD, high=MAX_PERIOD, units="s")
-        elif self.period is not None:
-            raise ParameterError(f"period applies only to measure 'sa', not {self.measure!r}")
-        real(self.damping, "damping", low=0.0, high=1.0, high_open=True)
-        choice(self.vertical, "vertical", VERTICAL_MODES)
-        levels = check_levels(self.levels, "levels", self.measure)
-        if self.scaled:
-            if levels.size == 0:
-                raise ParameterError(f"levels: a {self.kind!r} design needs at least one IM level")
-            if np.any(np.diff(levels) <= 0):
-                raise ParameterError("levels must be strictly increasing")
-        elif levels.size:
-            raise ParameterError("levels: a 'cloud' design uses the records as recorded; remove "
-                                 "the levels")
-        if self.vertical == "independent":
-            if not self.scaled:
-                raise ParameterError("vertical 'independent' needs scaled levels (not a cloud)")
-            v = check_levels(self.vertical_levels if self.vertical_levels is not None else (),
-                           "vertical_levels", self.measure)
-            if v.shape != levels.shape:
-                raise ParameterError(
-                    f"vertical_levels must give one vertical target per level ({levels.size})"
-                )
-        elif self.vertical_levels is not None:
-            raise ParameterError("vertical_levels apply only to vertical = 'independent'")
+        with _field("type"):
+            choice(self.kind, "type", DESIGN_TYPES)
+        with _field("measure"):
+            choice(self.measure, "measure", tuple(IM_MEASURES))
+        with _field("period"):
+            if self.measure == "sa":
+                if self.period is None:
+                    raise ParameterError("period [s] is required for measure 'sa'")
+                real(self.period, "period", low=MIN_PERIOD, high=MAX_PERIOD, units="s")
+            elif self.period is not None:
+                raise ParameterError(f"period applies only to measure 'sa', not "
+                                     f"{self.measure!r}")
+        with _field("damping"):
+            real(self.damping, "damping", low=0.0, high=1.0, high_open=True)
+        with _field("vertical"):
+            choice(self.vertical, "vertical", VERTICAL_MODES)
+        with _field("levels"):
+            levels = check_levels(self.levels, "levels", self.measure)
+            if self.scaled:
+                if levels.size == 0:
+                    raise ParameterError(f"levels: a {self.kind!r} design needs at least one IM "
+                                         "level")
+                if np.any(np.diff(levels) <= 0):
+                    raise ParameterError("levels must be strictly increasing")
+            elif levels.size:
+                raise ParameterError("levels: a 'cloud' design uses the records as recorded; "
+                                     "remove the levels")
+        with _field("vertical_levels"):
+            if self.vertical == "independent":
+                if not self.scaled:
+                    raise ParameterError("vertical 'independent' needs scaled levels (not a "
+                                         "cloud)")
+                v = check_levels(self.vertical_levels if self.vertical_levels is not None
+                                 else (), "vertical_levels", self.measure)
+                if v.shape != levels.shape:
+                    raise ParameterError(f"vertical_levels must give one vertical target per "
+                                         f"level ({levels.size})")
+            elif self.vertical_levels is not None:
+                raise ParameterError("vertical_levels apply only to vertical = 'independent'")
         return self
 
     def scale_options(self, level_index: int) -> dict:
@@ -347,8 +284,9 @@ class AnalysisDesign:
         Record ids (catalogue ids), the ``record`` dimension.
     intensity : IntensityDesign
         Analysis type, IM and levels (the ``im_level`` dimension, absent for a cloud).
-    system : ShipBlockSystem
-        The base system.
+    system : object
+        The base system of the model (a :class:`~shipblock.ShipBlockSystem` for the rigid
+        model).
     sweep : tuple of (str, tuple)
         ``(parameter, values)`` pairs, one dimension each, in order.
     stripes : tuple of tuple of str, optional
@@ -357,13 +295,20 @@ class AnalysisDesign:
         (e.g. matched to a conditional spectrum). Runs of a record outside a level's stripe
         are not made; their results are NaN and they count as invalid in every limit state.
         None (default): every record at every level.
+    model : shipblock.models.Model, optional
+        The model that runs the cases (default: the rigid model).
     """
 
     records: tuple[str, ...]
     intensity: IntensityDesign
-    system: ShipBlockSystem
+    system: object
     sweep: tuple[tuple[str, tuple], ...] = field(default_factory=tuple)
     stripes: tuple[tuple[str, ...], ...] | None = None
+    model: Model | None = None
+
+    def __post_init__(self):
+        if self.model is None:
+            object.__setattr__(self, "model", get_model(DEFAULT_MODEL))
 
     def validate(self) -> AnalysisDesign:
         """Check the grid and build every swept system once.
@@ -388,10 +333,11 @@ class AnalysisDesign:
         names = [name for name, _ in self.sweep]
         if len(set(names)) != len(names):
             raise ParameterError("a parameter is swept twice")
+        known = self.model.sweep_parameters
         for name, values in self.sweep:
-            if name not in SWEEP_PARAMETERS:
+            if name not in known:
                 raise ParameterError(
-                    f"unknown sweep parameter {name!r}; known: {', '.join(SWEEP_PARAMETERS)}"
+                    f"unknown sweep parameter {name!r}; known: {', '.join(known)}"
                 )
             if len(values) == 0:
                 raise ParameterError(f"sweep {name!r} has no values")
@@ -485,13 +431,13 @@ class AnalysisDesign:
         """int: Number of system-parameter combinations."""
         return int(np.prod(self.sweep_shape)) if self.sweep else 1
 
-    def systems(self) -> list[ShipBlockSystem]:
+    def systems(self) -> list:
         """Every swept system, in C order over the sweep dimensions.
 
         Returns
         -------
-        list of ShipBlockSystem
-            ``n_systems`` systems; a design without a sweep has just the base system.
+        list
+            ``n_systems`` systems of the model; a design without a sweep has just the base system.
 
         Raises
         ------
@@ -500,7 +446,7 @@ class AnalysisDesign:
         """
         return [self.system_at(i) for i in range(self.n_systems)]
 
-    def system_at(self, index: int) -> ShipBlockSystem:
+    def system_at(self, index: int):
         """The swept system of one system index (C order over the sweep dimensions).
 
         Parameters
@@ -510,7 +456,8 @@ class AnalysisDesign:
 
         Returns
         -------
-        ShipBlockSystem
+        object
+            The model's system (:meth:`Model.vary <shipblock.models.base.Model.vary>`).
 
         Raises
         ------
@@ -522,7 +469,7 @@ class AnalysisDesign:
         combo = np.unravel_index(int(index), self.sweep_shape)
         values = {name: vals[int(i)] for (name, vals), i in zip(self.sweep, combo, strict=True)}
         try:
-            return apply_parameters(self.system, values)
+            return self.model.vary(self.system, values)
         except ValueError as exc:
             raise ParameterError(f"sweep {values}: {exc}") from None
 
@@ -589,7 +536,7 @@ class AnalysisDesign:
                 },
             )
         for name, values in self.sweep:
-            units, long_name = SWEEP_PARAMETERS[name]
+            units, long_name = self.model.sweep_parameters[name]
             arr = np.asarray(values)
             if arr.dtype.kind in "iu":
                 arr = arr.astype(np.int64)
@@ -615,5 +562,4 @@ def as_sweep(mapping: Mapping[str, Sequence]) -> tuple[tuple[str, tuple], ...]:
     return tuple((str(k), tuple(v)) for k, v in mapping.items())
 
 
-#: ShipBlockSystem constructor fields (for validation of system tables).
-SYSTEM_FIELDS = tuple(f.name for f in fields(ShipBlockSystem))
+

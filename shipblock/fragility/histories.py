@@ -233,20 +233,21 @@ def run_case(design: AnalysisDesign, records, case: int, solver_options: Mapping
     case : int
         Case number.
     solver_options : mapping, optional
-        ``rtol``, ``atol``, ``zeno_omega`` as in the batch.
+        The model's solver options as in the batch (rigid model: ``rtol``, ``atol``,
+        ``zeno_omega``).
 
     Returns
     -------
     shipblock.SimulationResult
-        Equal bit for bit, in every summary value, to the batch's run of the case.
+        :meth:`Model.simulate <shipblock.models.base.Model.simulate>` of the design's model (a
+        :class:`~shipblock.SimulationResult` for the rigid model): equal bit for bit, in every
+        summary value, to the batch's run of the case.
 
     Raises
     ------
     ShipblockError
         If the case's record was left out of the batch (the message gives its error).
     """
-    from shipblock.solver import simulate
-
     r, j, s = (int(i) for i in design.case_indices([case])[0])
     rec = records[r]
     if rec.error is not None:
@@ -256,7 +257,7 @@ def run_case(design: AnalysisDesign, records, case: int, solver_options: Mapping
     f_v = fv[j]
     vertical = None if v is None or not np.isfinite(f_v) or f_v == 0.0 else f_v * v
     system = design.system_at(s)
-    return simulate(system, fh[j] * h, vertical, dt, **dict(solver_options or {}))
+    return design.model.simulate(system, fh[j] * h, vertical, dt, **dict(solver_options or {}))
 
 
 def case_dataset(result, design: AnalysisDesign, records, case: int,

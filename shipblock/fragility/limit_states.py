@@ -3,7 +3,7 @@ r"""Limit states: named thresholds on the engineering demand parameters (EDPs) o
 A limit state (LS) turns the per-run summary of a simulation into a yes/no outcome, for example
 "the ship slipped more than 5 cm on the blocks" or "a keel block carried more than its
 capacity" (``edp = "peak_ground_normal_force"``, or ``"peak_corner_load"`` for the load on a
-rocking block's edge: the contact loads of :mod:`shipblock.loads`, per block [N]). Counting
+rocking block's edge: the contact loads of :mod:`shipblock.interface_forces`, per block [N]). Counting
 these outcomes over records and IM levels gives the data that :mod:`shipblock.fragility.fit`
 turns into fragility curves.
 
@@ -44,13 +44,14 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from shipblock.errors import ParameterError
-from shipblock.interface_forces import LOAD_FIELDS
+from shipblock.models import DEFAULT_MODEL, Model, get_model
+from shipblock.models.base import EDPInfo  # noqa: F401  (importable from here as before)
+from shipblock.models.rigid import EDP_VARIABLES, FAILURE_CODES
 
 __all__ = [
     "CONDITIONS",
     "EDP_VARIABLES",
     "FAILURE_CODES",
-    "EDPInfo",
     "Exceedance",
     "LimitState",
     "evaluate_limit_states",
@@ -58,65 +59,12 @@ __all__ = [
     "parse_limit_states",
 ]
 
-#: Meaning of the integer ``failure`` code of a run summary.
-FAILURE_CODES: Mapping[int, str] = MappingProxyType({0: "none", 1: "separation", 2: "overturning"})
-
-
-class EDPInfo(NamedTuple):
-    """Description of one summary variable usable as an EDP.
-
-    Attributes
-    ----------
-    units : str
-        Units of the variable (``"1"`` for dimensionless).
-    long_name : str
-        Human-readable description.
-    kind : str
-        ``"float"`` (continuous, non-negative), ``"count"`` (non-negative integer), ``"bool"`` or
-        ``"code"`` (categorical integer, see :data:`FAILURE_CODES`).
-    response : bool
-        Whether it is a response quantity, so that collapse (``failure != 0``) exceeds every limit
-        state defined on it.
-    magnitude : bool
-        Whether the limit state compares the absolute value (for possibly signed residuals).
-    """
-
-    units: str
-    long_name: str
-    kind: str
-    response: bool
-    magnitude: bool = False
-
-
 #: Largest threshold accepted per EDP unit: beyond it no run can exceed the limit state, so the
 #: number is a typo or a unit mistake (a slip of 1 km, a rotation beyond half a turn, a load of a
 #: million tonnes on one block, a ratio or count of a billion).
 _LARGEST_THRESHOLD: Mapping[str, float] = MappingProxyType(
     {"m": 1e3, "rad": math.pi, "N": 1e10, "1": 1e9})
 
-
-#: Summary variables that limit states may refer to. ``failure_time`` [s] is also part of a run
-#: summary but is not an EDP (it is undefined for runs that did not fail).
-EDP_VARIABLES: Mapping[str, EDPInfo] = MappingProxyType(
-    {
-        "peak_block_slip": EDPInfo("m", "peak absolute block slip max|x_b|", "float", True),
-        "peak_ship_slip": EDPInfo("m", "peak absolute ship slip max|x_s|", "float", True),
-        "peak_rotation": EDPInfo("rad", "peak absolute block rotation max|theta|", "float", True),
-        "peak_rotation_ratio": EDPInfo(
-            "1", "peak rotation over critical rotation max|theta|/theta_c", "float", True
-        ),
-        "residual_block_slip": EDPInfo("m", "residual block slip", "float", True, True),
-        "residual_ship_slip": EDPInfo("m", "residual ship slip", "float", True, True),
-        "uplift": EDPInfo("1", "block uplift (rocking) occurred", "bool", True),
-        # contact loads, per block (shipblock.loads): e.g. "keel block load above its capacity"
-        **{name: EDPInfo(units, long_name, "float", True)
-           for name, (units, long_name) in LOAD_FIELDS.items()},
-        "n_impacts": EDPInfo("1", "number of rocking impacts", "count", True),
-        "failure": EDPInfo(
-            "1", "failure code (0 none, 1 separation, 2 overturning)", "code", False
-        ),
-    }
-)
 
 #: Conditions a limit state may use, with the EDP kinds each applies to.
 CONDITIONS: Mapping[str, tuple[str, ...]] = MappingProxyType(
@@ -162,8 +110,14 @@ class LimitState:
     condition: str = "greater"
     description: str = ""
 
-    def validate(self) -> LimitState:
+    def validate(self, model: Model | None = None) -> LimitState:
         """Check the definition and return it unchanged.
+
+        Parameters
+        ----------
+        model : shipblock.models.Model, optional
+            The model whose EDPs (:attr:`~shipblock.models.base.Model.edps`) and failure codes the
+            limit state refers to (default: the rigid model, :data:`EDP_VARIABLES`).
 
         Returns
         -------
@@ -177,23 +131,25 @@ class LimitState:
             condition or one that does not apply to the EDP, missing, superfluous, non-numeric,
             non-finite or negative threshold, or a failure code that does not exist.
         """
+        model = _model(model)
+        edps = model.edps
         who = f"limit state {self.name!r}"
         if not isinstance(self.name, str) or not self.name.strip():
             raise ParameterError(f"limit state name must be a non-empty string, got {self.name!r}")
-        if self.edp not in EDP_VARIABLES:
+        if self.edp not in edps:
             hint = (
                 " (failure_time is not an EDP; use edp = 'failure')"
                 if self.edp == "failure_time"
                 else ""
             )
             raise ParameterError(
-                f"{who}: unknown edp {self.edp!r}{hint}; known EDPs: {', '.join(EDP_VARIABLES)}"
+                f"{who}: unknown edp {self.edp!r}{hint}; known EDPs: {', '.join(edps)}"
             )
         if self.condition not in CONDITIONS:
             raise ParameterError(
                 f"{who}: unknown condition {self.condition!r}; use one of {', '.join(CONDITIONS)}"
             )
-        info = EDP_VARIABLES[self.edp]
+        info = edps[self.edp]
         if info.kind not in CONDITIONS[self.condition]:
             usable = [c for c, kinds in CONDITIONS.items() if info.kind in kinds]
             raise ParameterError(
@@ -212,17 +168,16 @@ class LimitState:
         if isinstance(t, bool) or not isinstance(t, numbers.Real) or not math.isfinite(t):
             raise ParameterError(f"{who}: threshold must be a finite number, got {t!r}")
         if info.kind == "code":
-            if t not in FAILURE_CODES or t == 0:
-                raise ParameterError(
-                    f"{who}: threshold {t!r} is not a failure code; use 1 (separation) or "
-                    "2 (overturning)"
-                )
+            if t not in model.failure_codes or t == 0:
+                codes = " or ".join(f"{c} ({what})" for c, what in model.failure_codes.items()
+                                    if c)
+                raise ParameterError(f"{who}: threshold {t!r} is not a failure code; use {codes}")
         elif t < 0:
             raise ParameterError(
                 f"{who}: threshold {t!r} [{info.units}] is negative but {self.edp!r} is compared "
                 "as a non-negative magnitude"
             )
-        elif t > _LARGEST_THRESHOLD[info.units]:
+        elif t > _LARGEST_THRESHOLD.get(info.units, math.inf):
             raise ParameterError(
                 f"{who}: threshold {t!r} [{info.units}] is beyond any value {self.edp!r} can take "
                 f"(at most {_LARGEST_THRESHOLD[info.units]:g} {info.units}); a unit mistake?"
@@ -234,7 +189,8 @@ class LimitState:
         return {k: v for k, v in asdict(self).items() if v is not None and v != ""}
 
 
-def parse_limit_states(entries: Sequence[Mapping[str, Any]]) -> tuple[LimitState, ...]:
+def parse_limit_states(entries: Sequence[Mapping[str, Any]],
+                       model: Model | None = None) -> tuple[LimitState, ...]:
     """Build validated limit states from the ``[[limit_states]]`` tables of a pipeline file.
 
     Parameters
@@ -242,6 +198,8 @@ def parse_limit_states(entries: Sequence[Mapping[str, Any]]) -> tuple[LimitState
     entries : sequence of mappings
         For example ``tomllib.load(f)["limit_states"]``. Keys: ``name`` and ``edp``
         (required), ``threshold``, ``condition`` (default ``"greater"``), ``description``.
+    model : shipblock.models.Model, optional
+        Whose EDPs the limit states use (default: the rigid model).
 
     Returns
     -------
@@ -284,7 +242,7 @@ def parse_limit_states(entries: Sequence[Mapping[str, Any]]) -> tuple[LimitState
             description=entry.get("description", ""),
         )
         try:
-            ls.validate()
+            ls.validate(model)
         except ValueError as err:
             raise ParameterError(f"{where}: {err}") from None
         if ls.name in seen:
@@ -323,7 +281,7 @@ def _get(summary, key, ls_name):
     return value if hasattr(value, "dims") else np.asarray(value)
 
 
-def exceedance(limit_state: LimitState, summary) -> Exceedance:
+def exceedance(limit_state: LimitState, summary, model: Model | None = None) -> Exceedance:
     r"""Evaluate a limit state on per-run summary variables.
 
     .. math::
@@ -342,6 +300,8 @@ def exceedance(limit_state: LimitState, summary) -> Exceedance:
         Per-run summary variables (see :data:`EDP_VARIABLES`), all of the same shape (or, for
         xarray, broadcastable dims). Must contain ``limit_state.edp`` and, for response EDPs,
         ``failure``.
+    model : shipblock.models.Model, optional
+        Whose EDPs the summary holds (default: the rigid model).
 
     Returns
     -------
@@ -366,8 +326,9 @@ def exceedance(limit_state: LimitState, summary) -> Exceedance:
     ``edp = "failure"`` the condition is applied to the code itself (so ``equal 2`` is exceeded
     only by overturning).
     """
-    ls = limit_state.validate()
-    info = EDP_VARIABLES[ls.edp]
+    model = _model(model)
+    ls = limit_state.validate(model)
+    info = model.edps[ls.edp]
     value = _get(summary, ls.edp, ls.name)
     missing = value != value  # NaN test that also works on int/bool arrays and DataArrays
     v = abs(value) if info.magnitude else value
@@ -404,7 +365,8 @@ def exceedance(limit_state: LimitState, summary) -> Exceedance:
     return Exceedance(exceeded=exceeded, valid=valid)
 
 
-def evaluate_limit_states(limit_states, summary) -> dict[str, Exceedance]:
+def evaluate_limit_states(limit_states, summary,
+                          model: Model | None = None) -> dict[str, Exceedance]:
     """Evaluate several limit states on the same summary.
 
     Parameters
@@ -413,10 +375,16 @@ def evaluate_limit_states(limit_states, summary) -> dict[str, Exceedance]:
         E.g. the output of :func:`parse_limit_states`.
     summary : Mapping[str, array_like] or xarray.Dataset
         Per-run summary variables, see :func:`exceedance`.
+    model : shipblock.models.Model, optional
+        Whose EDPs the summary holds (default: the rigid model).
 
     Returns
     -------
     dict[str, Exceedance]
         Keyed by limit state name, in input order.
     """
-    return {ls.name: exceedance(ls, summary) for ls in limit_states}
+    return {ls.name: exceedance(ls, summary, model) for ls in limit_states}
+
+
+def _model(model: Model | None) -> Model:
+    return get_model(DEFAULT_MODEL) if model is None else model

@@ -4,7 +4,7 @@ Two layers, both crash-safe:
 
 * :class:`ChunkStore` keeps one small ``.npz`` file per finished chunk in a directory
   (``<output>.partial/``), and in the same way the fitted fragility results after the batch
-  (group ``"fit"``, see :func:`shipblock.fragility.pipeline.fragility_variables`). Each file is
+  (group ``"fit"``, see :func:`shipblock.fragility.fit_step.fragility_variables`). Each file is
   written to a temporary name in the same directory and moved into place with
   :func:`os.replace`, which is atomic on POSIX and Windows, so a file with the final name is
   always complete. A ``manifest.json`` holds the fingerprint of the run (the pipeline, the
@@ -19,7 +19,8 @@ next run removes those of its own files (:func:`remove_stale_temporaries`,
 :meth:`ChunkStore.open`), never anything else.
 
 Every variable and coordinate of a result dataset carries ``units`` and ``long_name``;
-:data:`RUN_VARIABLES` lists those of the per-run summaries.
+:attr:`Model.outputs <shipblock.models.base.Model.outputs>` lists those of the per-run summaries
+(:data:`RUN_VARIABLES` those of the rigid model).
 """
 
 from __future__ import annotations
@@ -38,9 +39,7 @@ import numpy as np
 import xarray as xr
 
 from shipblock.errors import ShipblockError
-from shipblock.fragility.limit_states import EDP_VARIABLES
-from shipblock.modes import MODE_DESCRIPTIONS, MODE_FLAGS
-from shipblock.solver import MODE_TIME_FIELDS, SUMMARY_FIELDS
+from shipblock.models.rigid import RUN_VARIABLES
 
 __all__ = [
     "COMPRESSION_LEVEL",
@@ -66,44 +65,6 @@ _RANDOM = r"[A-Za-z0-9_]{8}"
 
 class StoreError(ShipblockError, ValueError):
     """A partial-results directory or result file cannot be used."""
-
-
-def _run_variables() -> dict[str, tuple[str, str]]:
-    extra = {
-        "peak_rotation_time": ("s", "time of the peak absolute block rotation"),
-        "failure_time": ("s", "time of separation or overturning (NaN if none)"),
-        "end_time": ("s", "time the simulation ended"),
-        "n_events": ("1", "number of mode transitions and impacts"),
-        "input_work": ("J", "work done by the ground motion"),
-        "friction_dissipation": ("J", "energy dissipated by friction"),
-        "impact_loss": ("J", "kinetic energy lost in rocking impacts"),
-        "n_jams": ("1", "number of jams of a slipping interface (Painleve regime)"),
-        "final_energy": ("J", "kinetic plus potential energy at the end of the run"),
-    }
-    out = {}
-    for name in [*SUMMARY_FIELDS, "peak_rotation_ratio", *MODE_TIME_FIELDS]:
-        if name in EDP_VARIABLES:
-            info = EDP_VARIABLES[name]
-            out[name] = (info.units, info.long_name)
-        elif name in extra:
-            out[name] = extra[name]
-        elif name.startswith("time_in_mode_"):
-            mode = int(name.rsplit("_", 1)[1])
-            flags = ", ".join(f"{what} {state[bit]}" for what, state, bit in zip(
-                ("blocks on ground", "blocks", "ship on blocks"),
-                (("stick", "slide"), ("at rest", "rocking"), ("stick", "slide")),
-                MODE_FLAGS[mode], strict=True))
-            out[name] = ("s", f"time spent in mode {mode}: {MODE_DESCRIPTIONS[mode]} ({flags})")
-        else:  # a summary field added to the solver later
-            out[name] = ("1", name.replace("_", " "))
-    return out
-
-
-#: Per-run summary variables of a result dataset: name -> (units, long name). All are stored as
-#: float64 with NaN for runs that produced no result (record or solver error); ``failure`` is
-#: the code 0 none, 1 separation, 2 overturning (a solver error, code 3, is stored as NaN and
-#: described in ``run_error``).
-RUN_VARIABLES: dict[str, tuple[str, str]] = _run_variables()
 
 
 # --------------------------------------------------------------------------------------------

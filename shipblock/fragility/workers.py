@@ -26,6 +26,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from urllib.parse import urlparse
 
+from shipblock.fragility.chunk import run_chunk
 from shipblock.solver._threads import usable_cores
 
 #: Serial estimate [s] from which the bootstrap's resamples go to local processes (without
@@ -88,7 +89,7 @@ def _task_numba_threads(hosts: dict[str, int] | None) -> int:
 
 
 def run_chunk_task(records, systems, cases, hosts=None, **options) -> dict:
-    """:func:`~shipblock.fragility.batch.run_chunk` as a Dask task, on its share of the cores.
+    """:func:`~shipblock.fragility.chunk.run_chunk` as a Dask task, on its share of the cores.
 
     Sets numba's thread count of the task's thread to :func:`numba_threads_per_task` of the
     worker's cores and of the task threads on its host (``hosts``, from
@@ -96,8 +97,6 @@ def run_chunk_task(records, systems, cases, hosts=None, **options) -> dict:
     chunk, and restores the count. The results do not depend on the thread count.
     """
     import numba
-
-    from shipblock.fragility.batch import run_chunk
 
     n = min(_task_numba_threads(hosts), numba.config.NUMBA_NUM_THREADS)
     before = numba.get_num_threads()

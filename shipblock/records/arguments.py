@@ -28,7 +28,7 @@ ALIGNS = ("trim", "resample", "strict")
 def check_read_arguments(*, inventory=None, units=None, response="sensitivity",
                          differentiate=False, align="trim", gaps="refuse", event=None,
                          format=None) -> dict:  # noqa: A002 - obspy's name for it
-    """Check the options :func:`read_motion` and :func:`shipblock.collection.read_motions` share.
+    """Check the options :func:`read_motion` and :func:`shipblock.records.folders.read_motions` share.
 
     Called before any file is read, so that a wrong option is one error naming it, not a
     failure of every record (``read_motions`` lists failures per record).

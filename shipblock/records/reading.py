@@ -132,7 +132,7 @@ def read_motion(
     paths_or_stream : str, os.PathLike, list of them, obspy.Stream or obspy.Trace
         One file with all components, several one-component files, traces in memory, or a
         folder or glob pattern holding exactly one record (use
-        :func:`shipblock.collection.read_motions` for a folder of many).
+        :func:`shipblock.records.folders.read_motions` for a folder of many).
     inventory : str, os.PathLike or obspy.Inventory, optional
         StationXML for raw counts (and channel azimuths/dips).
     units : str, optional
