@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import argparse
 import logging
+import signal
 import sys
 from contextlib import contextmanager
 from pathlib import Path
 
+from shipblock.processes import Terminated, terminate_as_interrupt
 from shipblock.units import STANDARD_GRAVITY
 
 log = logging.getLogger("shipblock")
@@ -709,17 +711,28 @@ def main(argv=None):
     try:
         from tqdm.contrib.logging import logging_redirect_tqdm
 
-        # log lines go above a progress bar, not onto its line
-        with logging_redirect_tqdm(), compile_notice(log.info, _log_compiled):
+        # log lines go above a progress bar, not onto its line; SIGTERM unwinds as Ctrl-C
+        with logging_redirect_tqdm(), compile_notice(log.info, _log_compiled), \
+                terminate_as_interrupt():
             return args.func(args)
     except (UserError, ShipblockError, ValueError, FileNotFoundError, OSError) as exc:
         if args.verbose > 1:
             raise
         sys.stderr.write(f"shipblock: error: {exc}\n")
         return 2
-    except KeyboardInterrupt:
-        sys.stderr.write("shipblock: interrupted\n")
-        return 130
+    except KeyboardInterrupt as exc:
+        return _interrupted(args, exc)
+
+
+def _interrupted(args, exc: KeyboardInterrupt) -> int:
+    """Say that the command was interrupted (Ctrl-C) or terminated (SIGTERM); the exit status
+    128 + the signal's number, as a shell reports a process ended by it."""
+    terminated = isinstance(exc, Terminated)
+    what = "terminated" if terminated else "interrupted"
+    if args.command == "run":
+        what += ("; finished runs and fits are kept: the same command again resumes from them")
+    sys.stderr.write(f"shipblock: {what}\n")
+    return 128 + (signal.SIGTERM if terminated else signal.SIGINT)
 
 
 if __name__ == "__main__":
