@@ -492,8 +492,11 @@ def cmd_process(args):
 
 
 def cmd_run(args):
+    from shipblock.fragility.filesystem import output_name_problem
     from shipblock.fragility.pipeline import run_pipeline
 
+    if args.output and (problem := output_name_problem(args.output)) is not None:
+        raise UserError(f"--output {args.output}: {problem}")
     ds = run_pipeline(args.pipeline, output=args.output, scheduler=args.scheduler,
                       progress=not args.quiet)
     out = sys.stdout

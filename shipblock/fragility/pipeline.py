@@ -145,6 +145,7 @@ from shipblock.fragility.fit import (
     fit_msa,
     ida_capacities,
 )
+from shipblock.fragility.filesystem import output_name_problem
 from shipblock.fragility.histories import (
     SelectionError,
     case_dataset,
@@ -1369,6 +1370,8 @@ def _prepare_output_folder(out_path: Path, source: str) -> None:
     Done before any work, so that an output that cannot be written fails at once, not after
     the batch.
     """
+    if (problem := output_name_problem(out_path)) is not None:  # issue 33
+        raise PipelineError("output", problem, source)
     try:
         out_path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
