@@ -498,7 +498,7 @@ def cmd_run(args):
     if args.output and (problem := output_name_problem(args.output)) is not None:
         raise UserError(f"--output {args.output}: {problem}")
     ds = run_pipeline(args.pipeline, output=args.output, scheduler=args.scheduler,
-                      progress=not args.quiet)
+                      progress=not args.quiet, wait=args.wait)
     out = sys.stdout
     out.write(f"results written to {ds.encoding.get('source', args.output or 'the pipeline output')}\n")
     from shipblock.fragility.report import study_report
@@ -641,6 +641,9 @@ def build_parser():
     s.add_argument("--output", "-o", help="NetCDF output (overrides the pipeline's)")
     s.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
     s.add_argument("--figure", help="PNG of the fragility curves")
+    s.add_argument("--wait", action="store_true",
+                   help="if another run is writing the same output, wait for it to end and then "
+                        "run (default: refuse, naming its process id)")
     s.set_defaults(func=cmd_run)
 
     s = sub.add_parser("history", help="full time histories of one run of a pipeline",

@@ -160,6 +160,7 @@ from shipblock.fragility.limit_states import (
     evaluate_limit_states,
     parse_limit_states,
 )
+from shipblock.fragility.lock import hold_output
 from shipblock.fragility.store import (
     ChunkStore,
     StoreError,
@@ -1365,7 +1366,7 @@ def _fingerprint(pipe: Pipeline, records) -> str:
 
 
 def _prepare_output_folder(out_path: Path, source: str) -> None:
-    """Create the output's folder, check it is writable and remove stale temporary files.
+    """Check the output's name, create its folder and check it is writable.
 
     Done before any work, so that an output that cannot be written fails at once, not after
     the batch.
@@ -1379,8 +1380,6 @@ def _prepare_output_folder(out_path: Path, source: str) -> None:
                             source) from None
     if not os.access(out_path.parent, os.W_OK | os.X_OK):
         raise PipelineError("output", f"cannot write in the folder {out_path.parent}", source)
-    for stale in remove_stale_temporaries(out_path):
-        logger.info("removed %s, left by an interrupted write of %s", stale.name, out_path.name)
 
 
 def _dask_client_class(scheduler: str, source: str):
@@ -1515,7 +1514,7 @@ def _loader(entry, pipe: Pipeline):
 
 
 def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool = True,
-                 timings: dict | None = None) -> xr.Dataset:
+                 timings: dict | None = None, wait: bool = False) -> xr.Dataset:
     """Run a pipeline file end to end and return the dataset it wrote.
 
     Parameters
@@ -1541,6 +1540,10 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         :func:`~shipblock.fragility.batch.run_chunk` when run locally), ``fragility``
         (dataset, limit states, fits), ``histories`` (time histories, if requested),
         ``write`` (NetCDF written and read back).
+    wait : bool
+        If another run holds the output (:func:`~shipblock.fragility.lock.hold_output`): wait
+        for it to end, then run (True), or raise
+        :class:`~shipblock.fragility.lock.OutputLockedError` naming its process (False).
 
     Returns
     -------
@@ -1556,11 +1559,9 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         installed (``pip install "shipblock[dask]"``) or its scheduler cannot be reached, every
         record was left out, or the partial directory belongs to another run. All of these
         are found before the batch starts.
+    OutputLockedError
+        If another run holds the output and ``wait`` is False.
     """
-    from shipblock import __version__
-    from shipblock.catalogue import load_catalogue
-    from shipblock.processing import DEFAULT_CHAIN
-
     for name, value, types, what in (("output", output, str | os.PathLike, "a file path"),
                                      ("scheduler", scheduler, str, "a scheduler address"),
                                      ("timings", timings, dict, "a dict")):
@@ -1572,6 +1573,20 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     out_path = (pipe.output if output is None
                 else _output_path(os.fspath(output), Path.cwd(), "run_pipeline(output=...)"))
     _prepare_output_folder(out_path, pipe.source)
+    with hold_output(out_path, wait=wait):  # issue 33: one run per output
+        return _run_held(pipe, out_path, client, scheduler, progress, timings, clock)
+
+
+def _run_held(pipe: Pipeline, out_path: Path, client, scheduler, progress: bool, timings,
+              clock: _StageClock) -> xr.Dataset:
+    """:func:`run_pipeline` once the run holds its output (the files left beside it are no
+    live run's)."""
+    from shipblock import __version__
+    from shipblock.catalogue import load_catalogue
+    from shipblock.processing import DEFAULT_CHAIN
+
+    for stale in remove_stale_temporaries(out_path):
+        logger.info("removed %s, left by an interrupted write of %s", stale.name, out_path.name)
     scheduler = scheduler or pipe.scheduler
     connect = _dask_client_class(scheduler, pipe.source) if client is None and scheduler else None
     design = pipe.design
