@@ -146,6 +146,16 @@ def test_output_names_are_checked_against_name_max_with_the_temporary_file(tmp_p
     assert filesystem.output_name_problem(tmp_path / ("é" * (longest // 2 + 1))) is not None
 
 
+def test_a_name_too_long_at_write_time_is_named(tmp_path):
+    """A history file's name comes from record ids and swept names: checked when written."""
+    path = tmp_path / ("h" * 250 + ".nc")  # fits NAME_MAX, its temporary file's name does not
+    with pytest.raises(StoreError) as info:
+        write_dataset(_noise(800), path)
+    assert str(info.value).startswith(f"cannot write {path}: a file name is too long")
+    assert f"at most {filesystem.name_max(tmp_path)} bytes" in str(info.value)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_250_byte_output_name_is_refused_before_the_run(tmp_path, monkeypatch, capsys):
     from shipblock.fragility import batch
 
