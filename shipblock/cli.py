@@ -9,11 +9,13 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import signal
 import sys
 import time
 from contextlib import contextmanager
 from pathlib import Path
 
+from shipblock.processes import Terminated, terminate_as_interrupt
 from shipblock.units import STANDARD_GRAVITY
 
 log = logging.getLogger("shipblock")
@@ -492,10 +494,13 @@ def cmd_process(args):
 
 
 def cmd_run(args):
+    from shipblock.fragility.filesystem import output_name_problem
     from shipblock.fragility.pipeline import run_pipeline
 
+    if args.output and (problem := output_name_problem(args.output)) is not None:
+        raise UserError(f"--output {args.output}: {problem}")
     ds = run_pipeline(args.pipeline, output=args.output, scheduler=args.scheduler,
-                      progress=not args.quiet)
+                      progress=not args.quiet, wait=args.wait)
     out = sys.stdout
     out.write(f"results written to {ds.encoding.get('source', args.output or 'the pipeline output')}\n")
     from shipblock.fragility.report import study_report
@@ -693,6 +698,9 @@ def build_parser():
     s.add_argument("--output", "-o", help="NetCDF output (overrides the pipeline's)")
     s.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
     s.add_argument("--figure", help="PNG of the fragility curves")
+    s.add_argument("--wait", action="store_true",
+                   help="if another run is writing the same output, wait for it to end and then "
+                        "run (default: refuse, naming its process id)")
     s.set_defaults(func=cmd_run)
 
     s = sub.add_parser("history", help="full time histories of one run of a pipeline",
@@ -839,17 +847,27 @@ def _run(args, compiled: dict) -> int:
     try:
         from tqdm.contrib.logging import logging_redirect_tqdm
 
-        # log lines go above a progress bar, not onto its line
-        with logging_redirect_tqdm(), compile_notice(log.info, done):
+        # log lines go above a progress bar, not onto its line; SIGTERM unwinds as Ctrl-C
+        with logging_redirect_tqdm(), compile_notice(log.info, done), terminate_as_interrupt():
             return args.func(args)
     except (UserError, ShipblockError, ValueError, FileNotFoundError, OSError) as exc:
         if args.verbose > 1:
             raise
         sys.stderr.write(f"shipblock: error: {exc}\n")
         return 2
-    except KeyboardInterrupt:
-        sys.stderr.write("shipblock: interrupted\n")
-        return 130
+    except KeyboardInterrupt as exc:
+        return _interrupted(args, exc)
+
+
+def _interrupted(args, exc: KeyboardInterrupt) -> int:
+    """Say that the command was interrupted (Ctrl-C) or terminated (SIGTERM); the exit status
+    128 + the signal's number, as a shell reports a process ended by it."""
+    terminated = isinstance(exc, Terminated)
+    what = "terminated" if terminated else "interrupted"
+    if args.command == "run":
+        what += ("; finished runs and fits are kept: the same command again resumes from them")
+    sys.stderr.write(f"shipblock: {what}\n")
+    return 128 + (signal.SIGTERM if terminated else signal.SIGINT)
 
 
 if __name__ == "__main__":

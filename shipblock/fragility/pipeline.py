@@ -44,6 +44,7 @@ from shipblock.fragility.batch import (
     run_batch,
     summary_dataset,
 )
+from shipblock.fragility.filesystem import output_name_problem
 from shipblock.fragility.fit_step import fragility_variables, limit_state_coords
 from shipblock.fragility.keys import (  # noqa: F401  (importable from here as before)
     MAX_BOOTSTRAP,
@@ -54,6 +55,7 @@ from shipblock.fragility.keys import (  # noqa: F401  (importable from here as b
     SCHEMA_VERSION,
     PipelineError,
 )
+from shipblock.fragility.lock import hold_output
 from shipblock.fragility.reruns import _rerun  # noqa: F401  (the CLI's rerun imports it here)
 from shipblock.fragility.reruns import (  # noqa: F401  (rerun_case: importable as before)
     add_histories,
@@ -109,11 +111,13 @@ def _fingerprint(pipe: Pipeline, records) -> str:
 
 
 def _prepare_output_folder(out_path: Path, source: str) -> None:
-    """Create the output's folder, check it is writable and remove stale temporary files.
+    """Check the output's name, create its folder and check it is writable.
 
     Done before any work, so that an output that cannot be written fails at once, not after
     the batch.
     """
+    if (problem := output_name_problem(out_path)) is not None:  # issue 33
+        raise PipelineError("output", problem, source)
     try:
         out_path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -121,8 +125,6 @@ def _prepare_output_folder(out_path: Path, source: str) -> None:
                             source) from None
     if not os.access(out_path.parent, os.W_OK | os.X_OK):
         raise PipelineError("output", f"cannot write in the folder {out_path.parent}", source)
-    for stale in remove_stale_temporaries(out_path):
-        logger.info("removed %s, left by an interrupted write of %s", stale.name, out_path.name)
 
 
 def _dask_client_class(scheduler: str, source: str):
@@ -277,7 +279,7 @@ def _add_record_use(ds, pipe: Pipeline, records, above, refused, left_out) -> xr
 
 
 def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool = True,
-                 timings: dict | None = None) -> xr.Dataset:
+                 timings: dict | None = None, wait: bool = False) -> xr.Dataset:
     """Run a pipeline file end to end and return the dataset it wrote.
 
     Parameters
@@ -303,6 +305,10 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         :func:`~shipblock.fragility.batch.run_chunk` when run locally), ``fragility``
         (dataset, limit states, fits), ``histories`` (time histories, if requested),
         ``write`` (NetCDF written and read back).
+    wait : bool
+        If another run holds the output (:func:`~shipblock.fragility.lock.hold_output`): wait
+        for it to end, then run (True), or raise
+        :class:`~shipblock.fragility.lock.OutputLockedError` naming its process (False).
 
     Returns
     -------
@@ -318,11 +324,9 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
         installed (``pip install "shipblock[dask]"``) or its scheduler cannot be reached, every
         record was left out, or the partial directory belongs to another run. All of these
         are found before the batch starts.
+    OutputLockedError
+        If another run holds the output and ``wait`` is False.
     """
-    # the records' stack (obspy) loads when records are read: start-up time of the CLI
-    from shipblock.records.catalogue import load_catalogue
-    from shipblock.processing import DEFAULT_CHAIN
-
     for name, value, types, what in (("output", output, str | os.PathLike, "a file path"),
                                      ("scheduler", scheduler, str, "a scheduler address"),
                                      ("timings", timings, dict, "a dict")):
@@ -334,6 +338,20 @@ def run_pipeline(path, output=None, client=None, scheduler=None, progress: bool 
     out_path = (pipe.output if output is None
                 else output_path(os.fspath(output), Path.cwd(), "run_pipeline(output=...)"))
     _prepare_output_folder(out_path, pipe.source)
+    with hold_output(out_path, wait=wait):  # issue 33: one run per output
+        return _run_held(pipe, out_path, client, scheduler, progress, timings, clock)
+
+
+def _run_held(pipe, out_path: Path, client, scheduler, progress: bool, timings,
+              clock: _StageClock) -> xr.Dataset:
+    """:func:`run_pipeline` once the run holds its output (the files left beside it are no
+    live run's)."""
+    # the records' stack (obspy) loads when records are read: start-up time of the CLI
+    from shipblock.processing import DEFAULT_CHAIN
+    from shipblock.records.catalogue import load_catalogue
+
+    for stale in remove_stale_temporaries(out_path):
+        logger.info("removed %s, left by an interrupted write of %s", stale.name, out_path.name)
     scheduler = scheduler or pipe.scheduler
     connect = _dask_client_class(scheduler, pipe.source) if client is None and scheduler else None
     design = pipe.design

@@ -39,6 +39,7 @@ import numpy as np
 import xarray as xr
 
 from shipblock.errors import ShipblockError
+from shipblock.fragility.filesystem import write_failure
 from shipblock.models.rigid import RUN_VARIABLES
 
 __all__ = [
@@ -122,19 +123,35 @@ def remove_stale_temporaries(path) -> list[Path]:
     return removed
 
 
+def _failed(path: Path, exc: BaseException, tmp: str | None, size: int | None = None):
+    """Remove the temporary file of a failed write; a StoreError naming the file and the cause
+    (:func:`~shipblock.fragility.filesystem.write_failure`), or None for other exceptions."""
+    problem = write_failure(path, exc, size)  # measured with the temporary file still there
+    if tmp is not None:
+        with contextlib.suppress(OSError):
+            # emptied first: HDF5 keeps a file it failed to close open, and an unlinked file
+            # still open would hold its space until the process ends
+            os.truncate(tmp, 0)
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+    return None if problem is None else StoreError(f"cannot write {path}: {problem}")
+
+
 def _atomic_write(path: Path, write) -> None:
     """Write ``path`` through a temporary file in the same directory and ``os.replace``."""
-    fd, tmp = _temporary(path)
+    tmp = None
     try:
+        fd, tmp = _temporary(path)
         with os.fdopen(fd, "wb") as fh:
             write(fh)
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+    except BaseException as exc:
+        error = _failed(path, exc, tmp)
+        if error is None:
+            raise
+        raise error from exc
 
 
 class ChunkStore:
@@ -356,19 +373,28 @@ def write_dataset(ds: xr.Dataset, path) -> Path:
     -------
     pathlib.Path
         ``path``.
+
+    Raises
+    ------
+    StoreError
+        If the file cannot be written: naming it and the cause (a full disk, with the space
+        left; a name too long; ...) rather than the NetCDF library's ``HDF error``. Nothing
+        is left behind.
     """
     check_metadata(ds)
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = _temporary(path)
-    os.close(fd)
+    tmp = None
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = _temporary(path)
+        os.close(fd)
         ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=_encoding(ds))
         os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+    except BaseException as exc:
+        error = _failed(path, exc, tmp, ds.nbytes)
+        if error is None:
+            raise
+        raise error from exc
     return path
 
 

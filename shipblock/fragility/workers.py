@@ -20,6 +20,7 @@ Two concerns of a study spread over cores or over a Dask cluster:
 
 from __future__ import annotations
 
+import os
 import sys
 import warnings
 from collections.abc import Callable, Sequence
@@ -27,6 +28,7 @@ from pathlib import Path
 from urllib.parse import urlparse
 
 from shipblock.fragility.chunk import run_chunk
+from shipblock.processes import pool_worker_start, stop_pool
 from shipblock.solver._threads import usable_cores
 
 #: Serial estimate [s] from which the bootstrap's resamples go to local processes (without
@@ -129,6 +131,8 @@ class Workers:
     On Linux the local processes are forked: they start in milliseconds and do not import the
     caller's main module again. Elsewhere they are spawned, which runs the main script again in
     each process: the pool is then used only when that is safe (:func:`main_is_safe_to_spawn`).
+    The processes die with this one, however it ends, and ignore Ctrl-C, which this one
+    handles (:mod:`shipblock.processes`).
     """
 
     def __init__(self, client=None, processes: int | None = None,
@@ -152,14 +156,19 @@ class Workers:
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc):
-        self.close()
+    def __exit__(self, exc_type, *exc):
+        self.close(abort=exc_type is not None)
 
-    def close(self):
-        """Shut the local pool down, if one was started."""
+    def close(self, abort: bool = False):
+        """Shut the local pool down, if one was started.
+
+        ``abort`` (an exception, Ctrl-C or SIGTERM leaving the ``with`` block): cancel the
+        work not started and stop the workers at once
+        (:func:`~shipblock.processes.stop_pool`).
+        """
         if self._pool is not None:
-            self._pool.shutdown()
-            self._pool = None
+            pool, self._pool = self._pool, None
+            stop_pool(pool, abort)
 
     def slots(self) -> int:
         """Work items that can run at once where the next large map would go."""
@@ -200,8 +209,11 @@ class Workers:
             if self._pool is None:
                 from concurrent.futures import ProcessPoolExecutor
 
+                # workers die with this process and leave Ctrl-C to it (processes.py)
                 self._pool = ProcessPoolExecutor(max_workers=self.processes,
-                                                 mp_context=self._context)
+                                                 mp_context=self._context,
+                                                 initializer=pool_worker_start,
+                                                 initargs=(os.getpid(),))
             with warnings.catch_warnings():
                 # Python 3.12+ warns that forking a process with threads may deadlock the
                 # child; the children only fit (numpy, scipy) and hold no lock of ours
