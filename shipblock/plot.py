@@ -8,10 +8,18 @@ the data stay SI.
 
 from __future__ import annotations
 
+import json
+import textwrap
+from collections.abc import Mapping
+from pathlib import PurePath
+
 import numpy as np
 
 from shipblock.errors import ParameterError
+from shipblock.fragility.design import apply_parameters
+from shipblock.fragility.report import display_units, im_label
 from shipblock.modes import MODE_DESCRIPTIONS
+from shipblock.system import ShipBlockSystem
 from shipblock.units import STANDARD_GRAVITY
 
 #: One colour per mode (1..8), light enough to sit behind the curves.
@@ -312,10 +320,101 @@ def plot_spectrum(acc, dt, periods=None, damping=0.05, ax=None, label=None, **li
     return ax
 
 
+def system_text(system) -> str:
+    """One line naming a ship-block system as a report would: masses in t, block size in m,
+    friction static/kinetic per interface.
+
+    Parameters
+    ----------
+    system : ShipBlockSystem or Mapping
+        The system, or its :meth:`~shipblock.system.ShipBlockSystem.to_dict`.
+
+    Returns
+    -------
+    str
+        e.g. ``"ship 5000 t on 150 blocks of 1.2 t, 2B x 2H = 0.6 x 1.2 m; friction
+        blocks-floor 0.6/0.55, ship-blocks 0.35/0.3 (static/kinetic)"``.
+    """
+    d = system if isinstance(system, Mapping) else system.to_dict()
+    return (f"ship {float(d['ship_mass']) / 1e3:.4g} t on {int(d['n_blocks'])} blocks of "
+            f"{float(d['block_mass']) / 1e3:.3g} t, 2B x 2H = {2 * float(d['half_width']):.3g} x "
+            f"{2 * float(d['half_height']):.3g} m; friction blocks-floor "
+            f"{float(d['mu_s_ground']):.3g}/{float(d['mu_k_ground']):.3g}, ship-blocks "
+            f"{float(d['mu_s_ship']):.3g}/{float(d['mu_k_ship']):.3g} (static/kinetic)")
+
+
+_DESIGN_NAMES = {"ida": "IDA", "msa": "MSA", "cloud": "cloud"}
+_VERTICAL_TEXT = {"same": "vertical scaled with the horizontal",
+                  "independent": "vertical scaled to its own levels",
+                  "unscaled": "vertical as recorded", "zero": "no vertical"}
+
+
+def study_caption(ds, sweep=None) -> list[str]:
+    """What study, system and design a result shows: three lines for a figure's title.
+
+    The study is the pipeline's ``title`` and file (attributes ``title`` and
+    ``pipeline_source``); the system is the pipeline's, with the swept values drawn
+    (``sweep``) applied (:func:`shipblock.fragility.design.apply_parameters`); the design names
+    the analysis (IDA, MSA or cloud), the measure, the records and levels run, and the
+    vertical.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A result of :func:`shipblock.run_pipeline`.
+    sweep : dict, optional
+        Swept parameter -> value drawn (:func:`sweep_selection`).
+
+    Returns
+    -------
+    list of str
+        ``[study, "system: ...", "design: ..."]``; a line whose attributes are missing (a file
+        of an older version) is left out.
+    """
+    lines = []
+    title = str(ds.attrs.get("title", "")).strip()
+    source = str(ds.attrs.get("pipeline_source", "")).strip()
+    if source and (PurePath(source).is_absolute() or len(source) > 40):
+        source = PurePath(source).name
+    if title or source:
+        lines.append(title + (f" ({source})" if source and title else source))
+    if "system" in ds.attrs:
+        system = json.loads(ds.attrs["system"])
+        if sweep:
+            system = apply_parameters(ShipBlockSystem(**system), dict(sweep)).to_dict()
+        lines.append("system: " + system_text(system))
+    kind = str(ds.attrs.get("design_type", ""))
+    if kind:
+        measure = im_label(ds).rsplit(" [", 1)[0]
+        n_rec = int(ds.attrs.get("n_records_used", ds.sizes.get("record", 0)))
+        text = f"design: {_DESIGN_NAMES.get(kind, kind)} on {measure}, {n_rec} records"
+        if "im_level" in ds.coords:
+            levels, _, _ = _im_axis(ds, ds["im_level"].values)
+            unit = display_units(ds)[0]
+            text += (f" x {levels.size} levels ({levels.min():.3g} to {levels.max():.3g} {unit})")
+        else:
+            text += " at their own intensity"
+        vertical = _VERTICAL_TEXT.get(str(ds.attrs.get("vertical_mode", "")))
+        if vertical:
+            text += f"; {vertical}"
+        lines.append(text)
+    return lines
+
+
+#: Longest title line of a study figure [characters]: about the width of the default figure
+#: at the title's font size.
+TITLE_WIDTH = 140
+
+
+def _title(ax, caption, what):
+    """Title of a study figure: the caption lines (:func:`study_caption`), then what it shows,
+    each wrapped to :data:`TITLE_WIDTH`."""
+    lines = [w for line in [*caption, *what] for w in textwrap.wrap(line, TITLE_WIDTH)]
+    ax.set_title("\n".join(lines), fontsize=8.5, loc="left")
+
+
 def _im_axis(ds, values):
     """IM values for display in the pipeline's unit (g for ``levels_g``): (values, label, factor)."""
-    from shipblock.fragility.report import display_units, im_label
-
     unit, factor = display_units(ds)
     return np.asarray(values, float) / factor, im_label(ds), factor
 
@@ -402,19 +501,37 @@ def limit_state_text(ds, name) -> str:
 _MARKERS = ("o", "s", "^", "D", "v", "P", "X", "<", ">", "h")
 
 
-#: Sideways offset between the observed fractions of successive limit states, as a fraction
-#: of the IM axis [-].
+#: Sideways offset between the medians of successive limit states in
+#: :func:`plot_median_sweep`, as a fraction of the swept parameter's range [-].
 DODGE = 0.012
+
+#: Marker size of the innermost observed fractions [pt]; each limit state before it is
+#: :data:`MARKER_STEP` larger, so that coinciding fractions nest (see :func:`plot_fragility`).
+MARKER_SIZE = 5.0
+MARKER_STEP = 2.2
+
+
+def marker_sizes(n: int) -> list[float]:
+    """Marker size of each of ``n`` limit states: the first the largest, the last
+    :data:`MARKER_SIZE` (nested hollow markers)."""
+    return [MARKER_SIZE + MARKER_STEP * (n - 1 - i) for i in range(n)]
 
 
 def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
     """Fitted lognormal fragility curves with the observed fractions of exceedance.
 
-    The legend gives each limit state's definition (EDP, condition, threshold with its units)
-    and fit; the title the number of records per level and, for a sweep, the swept values
-    drawn. Observed fractions of different limit states that coincide (typically 0 and 1 at
-    the ends) are told apart by marker and drawn side by side: limit state ``i`` of ``n`` is
-    offset by ``(i - (n - 1)/2)`` times :data:`DODGE` of the axis (the curves are not moved).
+    The title says which study (pipeline title and file), system (with the swept values drawn)
+    and design (analysis, measure, records x levels) the figure shows (:func:`study_caption`),
+    then what is drawn: the bootstrap band is named only when one is drawn. The legend gives
+    each limit state's definition (EDP, condition, threshold with its units) and fit.
+
+    The observed fractions are drawn at the intensity they were observed at, not moved
+    sideways: a report's reader takes values off the figure, and a marker moved by a few
+    hundredths of a g would misplace the point it stands for. Fractions of different limit
+    states that coincide (typically 0 and 1 at the ends) stay visible as *nested* hollow
+    markers: each limit state has its own shape, and the first is the largest
+    (:func:`marker_sizes`), so a small triangle inside a larger square inside a circle reads
+    as "all three". The title says so.
 
     Parameters
     ----------
@@ -432,10 +549,11 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
     -------
     matplotlib.axes.Axes
     """
+    from matplotlib.lines import Line2D
     from scipy.stats import norm
 
     if ax is None:
-        _, axs = _new_axes(1, height=4.0)
+        _, axs = _new_axes(1, height=4.6)
         ax = axs[0]
     sweep = sweep_selection(ds, sweep)
     names = list(ds["limit_state"].values)
@@ -447,15 +565,12 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
     x_max = 1.15 * float(np.nanmax(x_obs_si if scaled else ds["achieved_im"].values))
     x_si = np.linspace(x_max / 400, x_max, 400)
     x_plot, xlabel, _ = _im_axis(ds, x_si)
-    from matplotlib.lines import Line2D
-
-    from shipblock.fragility.report import display_units
-
-    colours = [f"C{i}" for i in range(10)]
+    sizes = marker_sizes(len(names))
     n_per_level = None
     handles = []
+    band_drawn = False
     for i, name in enumerate(names):
-        c = colours[i % 10]
+        c = f"C{i % 10}"
         marker = _MARKERS[i % len(_MARKERS)]
         median = float(_select_sweep(ds["median"].sel(limit_state=name), sweep))
         beta = float(_select_sweep(ds["beta"].sel(limit_state=name), sweep))
@@ -466,14 +581,16 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
             desc += f": median {med_plot[0]:.3g} {display_units(ds)[0]}, beta {beta:.2f}"
         else:
             desc += ": no fit"
-        handles.append(Line2D([], [], color=c, lw=1.8 if fitted else 0, marker=marker,
-                              mfc="white", mew=1.5, ms=5.5, label=desc))
+        handles.append(Line2D([], [], color=c, lw=1.8 if fitted else 0,
+                              marker=marker if scaled else None, mfc="white", mew=1.5,
+                              ms=sizes[i], label=desc))
         if fitted:
             ax.plot(x_plot, norm.cdf(np.log(x_si / median) / beta), color=c, lw=1.8)
             if "median_lower" in ds:
                 lo = float(_select_sweep(ds["median_lower"].sel(limit_state=name), sweep))
                 hi = float(_select_sweep(ds["median_upper"].sel(limit_state=name), sweep))
                 if np.isfinite(lo) and np.isfinite(hi):
+                    band_drawn = True
                     ax.fill_between(x_plot, norm.cdf(np.log(x_si / hi) / beta),
                                     norm.cdf(np.log(x_si / lo) / beta), color=c, alpha=0.15,
                                     lw=0)
@@ -486,27 +603,31 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
                 n_per_level = n
             frac = np.where(n > 0, n_ex / np.maximum(n, 1), np.nan)
             xo, _, _ = _im_axis(ds, x_obs_si)
-            # side by side at each level, a marker's width apart (about 1.2 % of the axis)
-            dodge = DODGE * x_plot[-1] * (i - (len(names) - 1) / 2)
-            ax.plot(xo + dodge, frac, marker, color=c, ms=5.5, mfc="white", mew=1.5, zorder=3)
+            # at the level itself; the first limit state's marker the largest (nested)
+            ax.plot(xo, frac, marker, color=c, ms=sizes[i], mfc="none", mew=1.5, zorder=3 + i)
     ax.set_xlabel(xlabel)
     ax.set_ylabel("probability of exceedance")
     ax.set_ylim(-0.03, 1.03)
     ax.set_xlim(0, x_plot[-1])
     ax.grid(True, lw=0.3, alpha=0.5)
-    parts = []
+    curves = "fragility: lines: lognormal fit"
+    if band_drawn:
+        conf = ds["median_lower"].attrs.get("confidence")
+        curves += ("; shaded: " + (f"{100 * float(conf):g} % " if conf is not None else "")
+                   + "bootstrap band of the median")
+    if sweep:
+        curves += f"; drawn at {_sweep_text(sweep)}"
+    what = [curves]
     if n_per_level is not None:
         counts = np.unique(n_per_level)
-        parts.append(f"{int(counts[0])} records per level" if counts.size == 1 else
+        per_level = (f"{int(counts[0])} records per level" if counts.size == 1 else
                      "records per level: " + ", ".join(str(int(k)) for k in n_per_level))
-    elif not scaled:
-        parts.append(f"{int(ds['valid'].sel(limit_state=names[0]).pipe(_select_sweep, sweep).sum())}"
-                     " records")
-    if sweep:
-        parts.append(_sweep_text(sweep))
-    band = "; shaded: bootstrap band of the median" if "median_lower" in ds else ""
-    ax.set_title("fragility: lognormal fit (lines), observed fractions (markers)" + band
-                 + ("\n" + "; ".join(parts) if parts else ""), fontsize=9)
+        what.append(f"markers: fraction of the {per_level} exceeding, at the level itself "
+                    "(not shifted; coinciding ones nest, largest first)")
+    else:
+        n_rec = int(ds["valid"].sel(limit_state=names[0]).pipe(_select_sweep, sweep).sum())
+        what.append(f"{n_rec} records at their own intensity (no fractions per level)")
+    _title(ax, study_caption(ds, sweep), what)
     ax.legend(handles=handles, fontsize=7.5, loc="best")
     return ax
 
@@ -515,7 +636,10 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
     """Fitted median against a swept parameter, with its bootstrap band, per limit state.
 
     Limit states are drawn side by side (offset by :data:`DODGE` of the parameter's range), so
-    that equal medians stay visible; the legend names the values where a fit failed.
+    that equal medians and their bars stay visible: the swept values are a few known settings
+    (the ticks), not a measured abscissa, so the offset misplaces nothing, and the title says
+    it. The legend names the values where a fit failed; the title the study, system and design
+    (:func:`study_caption`; the system with the other swept values drawn).
 
     Parameters
     ----------
@@ -555,9 +679,10 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
     x = ds[parameter].values.astype(float)
     span = float(np.ptp(x)) or 1.0
     _, ylabel, factor = _im_axis(ds, [])
+    bars_drawn = False
     for i, name in enumerate(names):
         c = f"C{i % 10}"
-        # limit states with equal medians side by side, as in plot_fragility
+        # limit states with equal medians side by side
         xd = x + DODGE * span * (i - (len(names) - 1) / 2)
         med = ds["median"].sel(limit_state=name).sel(others).values / factor
         label = f"{name} ({limit_state_text(ds, name)})"
@@ -569,6 +694,7 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
         if "median_lower" in ds:
             lo = ds["median_lower"].sel(limit_state=name).sel(others).values / factor
             hi = ds["median_upper"].sel(limit_state=name).sel(others).values / factor
+            bars_drawn = bars_drawn or bool(np.isfinite(lo).any() and np.isfinite(hi).any())
             ax.errorbar(xd, med, yerr=[med - lo, hi - med], fmt="none", ecolor=c, elinewidth=1,
                         capsize=3)
     units = ds[parameter].attrs.get("units", "")
@@ -577,11 +703,20 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
                   + (f": {long_name}" if long_name else ""))
     ax.set_ylabel(f"median {ylabel}")
     ax.grid(True, lw=0.3, alpha=0.5)
-    band = " (bars: bootstrap band)" if "median_lower" in ds else ""
-    title = f"fitted median against {parameter}{band}"
+    what = f"fitted median against {parameter}"
+    if bars_drawn:
+        conf = ds["median_lower"].attrs.get("confidence")
+        what += "; bars: " + (f"{100 * float(conf):g} % " if conf is not None else "") \
+            + "bootstrap band"
+    if len(names) > 1:
+        what += (f"; limit states side by side, {100 * DODGE:g} % of the {parameter} range "
+                 "apart")
     if others:
-        title += "\n" + _sweep_text(others)
-    ax.set_title(title, fontsize=9)
+        what += f"; drawn at {_sweep_text(others)}"
+    # the system line holds the base value of the parameter on the x axis: say it is swept
+    caption = [line + (f"; {parameter} swept (x axis)" if line.startswith("system: ") else "")
+               for line in study_caption(ds, others)]
+    _title(ax, caption, [what])
     ax.legend(fontsize=7.5)
     return ax
 
@@ -589,7 +724,8 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
 def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
     """IDA curves: the demand ``edp`` of each record against the intensity it was scaled to.
 
-    Runs that failed (separation, overturning) are marked with a cross at the right edge.
+    Runs that failed (separation, overturning) are marked with a cross at the right edge. The
+    title says which study, system and design the curves come from (:func:`study_caption`).
 
     Parameters
     ----------
@@ -627,7 +763,11 @@ def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
     ax.set_xlabel(f"{ds[edp].attrs.get('long_name', edp)} [{unit_label}]")
     ax.set_ylabel(ylabel)
     ax.grid(True, lw=0.3, alpha=0.5)
-    ax.set_title("IDA curves (x: failure)" + (f"; {_sweep_text(sweep)}" if sweep else ""),
-                 fontsize=9)
+    what = (f"IDA curves: {ds[edp].attrs.get('long_name', edp)} of each record against the "
+            f"intensity it was scaled to; x: failure (separation, overturning), drawn at the "
+            f"right edge")
+    if sweep:
+        what += f"; drawn at {_sweep_text(sweep)}"
+    _title(ax, study_caption(ds, sweep), [what])
     ax.legend(fontsize=8, ncol=2)
     return ax
