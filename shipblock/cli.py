@@ -221,25 +221,72 @@ def _system_from_args(args):
     return system.replace(**changes) if changes else system
 
 
+def _target_pga(text: str) -> float:
+    """``--target-pga`` as m/s^2: a number with its unit (``0.4g``, ``3.9 m/s^2``, ``392gal``)."""
+    import re
+
+    from shipblock.units import acceleration_to_si
+
+    match = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S*)\s*", text)
+    if match is None:
+        raise UserError(f"--target-pga {text!r}: expected a number and its unit, e.g. 0.4g")
+    value, unit = float(match.group(1)), match.group(2)
+    if not unit:
+        raise UserError(f"--target-pga {text}: give its unit, e.g. {text}g, {text}m/s^2 or "
+                        f"{text}gal (a bare number would be m/s^2)")
+    try:
+        target = float(acceleration_to_si(value, unit))
+    except ValueError as exc:
+        raise UserError(f"--target-pga {text}: {exc}") from None
+    if not target > 0:
+        raise UserError(f"--target-pga {text}: must be above zero")
+    return target
+
+
+def _scaled_input(args, motion):
+    """The horizontal and vertical to simulate, and the scale phrase of the figure's title."""
+    from shipblock.scaling import scale_record
+
+    vertical = None if args.no_vertical else motion.vertical
+    if args.target_pga is None:
+        factor = 1.0 if args.scale is None else args.scale
+        ax = motion.horizontal * factor
+        ay = None
+        if vertical is not None:
+            ay = vertical * (factor if args.vertical_scale is None else args.vertical_scale)
+        return ax, ay, factor
+    if args.scale is not None:
+        raise UserError("give --scale or --target-pga, not both")
+    target = _target_pga(args.target_pga)
+    options = {"target": target, "measure": "pga"}
+    if vertical is not None and args.vertical_scale is not None:
+        options.update(vertical_mode="independent", vertical_factor=args.vertical_scale)
+    scaled = scale_record(motion.horizontal, vertical, motion.dt, **options)
+    log.info("scaled to PGA %.4g g: factor %.4g on the horizontal%s", target / STANDARD_GRAVITY,
+             scaled.factor_h, "" if vertical is None else f", {scaled.factor_v:.4g} on the vertical")
+    return (scaled.horizontal, scaled.vertical,
+            f"scaled to PGA {target / STANDARD_GRAVITY:.3g} g (factor {scaled.factor_h:.4g})")
+
+
 def cmd_simulate(args):
+    from shipblock.plot import record_text
     from shipblock.solver import simulate
 
     system = _system_from_args(args)
     motion = _load_motion(args)
-    ax = motion.horizontal * args.scale
-    ay = None
-    if motion.vertical is not None and not args.no_vertical:
-        ay = motion.vertical * (args.scale if args.vertical_scale is None else args.vertical_scale)
+    ax, ay, scale = _scaled_input(args, motion)
     log.info("simulating %d samples at dt = %g s", ax.size, motion.dt)
     res = simulate(system, ax, ay, motion.dt, rtol=args.rtol)
     name = motion.name
+    record = record_text(motion, scale)
     _report(res, name, args.events)
     if args.output:
         ds = res.to_dataset()
         ds.attrs["record"] = str(name)
+        ds.attrs["record_description"] = record
         ds.attrs["processing"] = "\n".join(motion.metadata.get("processing", []) or [])
         _write_response(ds, args.output)
-    _response_figure_option(res, name, args.figure, args.output)
+    _response_figure_option(res, record, args.figure, args.output)
     return 0
 
 
@@ -250,11 +297,11 @@ def _write_response(ds, output):
     sys.stdout.write(f"response written to {output}\n")
 
 
-def _response_figure_option(res, name, figure, output):
+def _response_figure_option(res, record, figure, output):
     if figure is None and output:
         figure = str(Path(output).with_suffix(".png"))
     if figure:
-        _save_figure(lambda: _response_figure(res, name), figure)
+        _save_figure(lambda: _response_figure(res, record), figure)
         sys.stdout.write(f"figure written to {figure}\n")
 
 
@@ -338,9 +385,12 @@ def cmd_history(args):
     sys.stdout.write(f"run {ds.attrs['case']} of {args.pipeline}: {name}{level}, scale factor "
                      f"{ds.attrs['scale_factor']:.4g}\n")
     _report(res, name, args.events)
+    record = (f"record {_run_name(ds)}, scale factor {ds.attrs['scale_factor']:.4g}: run "
+              f"{ds.attrs['case']} of {args.pipeline}")
+    ds.attrs["record_description"] = record
     if args.output:
         _write_response(ds, args.output)
-    _response_figure_option(res, name, args.figure, args.output)
+    _response_figure_option(res, record, args.figure, args.output)
     return 0
 
 
@@ -359,13 +409,11 @@ def _run_name(ds):
     return name
 
 
-def _response_figure(res, name):
+def _response_figure(res, record):
+    """The response figure, ``record`` the first line of its title (:func:`plot_response`)."""
     from shipblock.plot import plot_response
 
-    axes = plot_response(res)
-    if name:
-        axes[0].figure.suptitle(f"{name}: " + axes[0].figure._suptitle.get_text())
-    return axes[0].figure
+    return plot_response(res, record=record)[0].figure
 
 
 def _save_figure(make, path):
@@ -520,7 +568,10 @@ def cmd_plot(args):
         ds = ds.load()
     figure = args.figure or str(Path(args.results).with_suffix(".png"))
     if "x_b" in ds and "time" in ds.dims:
-        _save_figure(lambda: _response_figure(ds, _run_name(ds)), figure)
+        record = ds.attrs.get("record_description") or (
+            f"record {_run_name(ds)}" + (f", scale factor {float(ds.attrs['scale_factor']):.4g}"
+                                         if "scale_factor" in ds.attrs else ""))
+        _save_figure(lambda: _response_figure(ds, record), figure)
         sys.stdout.write(f"figure written to {figure}\n")
         return 0
     if "median" not in ds:
@@ -532,8 +583,7 @@ def cmd_plot(args):
     except ValueError as exc:
         raise UserError(f"{args.results}: --set {exc}") from None
     if args.kind == "ida":
-        if args.edp not in ds:
-            raise UserError(f"{args.results}: no demand parameter {args.edp!r}")
+        _check_edp(ds, args.edp, args.results)
         _save_figure(lambda: plot_ida(ds, args.edp, sweep=sweep).figure, figure)
     elif args.kind == "median":
         if not sweep:
@@ -547,6 +597,22 @@ def cmd_plot(args):
         _save_figure(lambda: plot_fragility(ds, sweep=sweep).figure, figure)
     sys.stdout.write(f"figure written to {figure}\n")
     return 0
+
+
+def _check_edp(ds, edp, results):
+    """Refuse an ``--edp`` the results do not hold, listing those they do (and the closest)."""
+    import difflib
+
+    from shipblock.fragility.limit_states import EDP_VARIABLES
+
+    valid = [k for k, info in EDP_VARIABLES.items()
+             if k in ds and info.kind in ("float", "count")]
+    if edp in valid:
+        return
+    close = difflib.get_close_matches(edp, valid, n=1)
+    raise UserError(f"{results}: --edp {edp!r} is not a demand parameter of these results"
+                    + (f" (did you mean {close[0]!r}?)" if close else "")
+                    + f"; valid: {', '.join(valid)}")
 
 
 def cmd_bench(args):
@@ -599,7 +665,11 @@ def build_parser():
     for key, (flag, typ, help_) in SYSTEM_FLAGS.items():
         g.add_argument(flag, dest=key, type=typ, help=help_)
     g = s.add_argument_group("run")
-    g.add_argument("--scale", type=float, default=1.0, help="factor on the horizontal (and vertical)")
+    g.add_argument("--scale", type=float,
+                   help="factor on the horizontal (and vertical); default 1")
+    g.add_argument("--target-pga", metavar="PGA",
+                   help="scale to this PGA of the horizontal, with its unit: 0.4g, 3.9m/s^2, "
+                        "392gal (the vertical by the same factor unless --vertical-scale)")
     g.add_argument("--vertical-scale", type=float, help="independent factor on the vertical")
     g.add_argument("--no-vertical", action="store_true", help="ignore the vertical component")
     g.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of rocking phases")

@@ -9,6 +9,7 @@ the data stay SI.
 from __future__ import annotations
 
 import json
+import math
 import textwrap
 from collections.abc import Mapping
 from pathlib import PurePath
@@ -75,8 +76,6 @@ class _DatasetResponse:
     """Read-only view of a response Dataset (from ``SimulationResult.to_dataset``) for plotting."""
 
     def __init__(self, ds):
-        import math
-
         from shipblock.result import Event
 
         self.time = ds["time"].values
@@ -95,12 +94,65 @@ class _DatasetResponse:
         failure = ds.attrs.get("failure", "none")
         self.failure = None if failure == "none" else failure
         self.failure_time = float(ds.attrs.get("failure_time_s", float("nan")))
+        self.system = {k[len("system_"):]: v for k, v in ds.attrs.items()
+                       if k.startswith("system_")}
+        self.system["critical_angle"] = math.atan2(float(ds.attrs["system_half_width"]),
+                                                   float(ds.attrs["system_half_height"]))
+        #: the record line of the title (written by ``shipblock simulate`` and ``history``)
+        self.record = str(ds.attrs.get("record_description", ds.attrs.get("record", "")))
 
-        class _System:
-            critical_angle = math.atan2(float(ds.attrs["system_half_width"]),
-                                        float(ds.attrs["system_half_height"]))
 
-        self.system = _System()
+def record_text(motion, scale=None) -> str:
+    """One line naming a record as a report would: id, station and site, the horizontal used
+    (component, channel, azimuth), the event or the start date, and the scale factor.
+
+    Parameters
+    ----------
+    motion : GroundMotion
+        The record as read (its ``metadata``: catalogue, station, channels, azimuths, event,
+        the horizontal chosen).
+    scale : float or str, optional
+        Scale factor applied (a number), or a phrase such as ``"scaled to PGA 0.4 g (factor
+        1.03)"``; left out when None.
+
+    Returns
+    -------
+    str
+        e.g. ``"record south-napa-2014/NP.1765 (CA:Napa;FS 3): horizontal H1 = NP.1765..HNN
+        (0 deg), event 2014-08-24 10:20:44 UTC Mw 6.02, scale factor 2.6"``.
+    """
+    md = motion.metadata
+    site = (md.get("catalogue") or {}).get("site", "")
+    station = md.get("station")
+    # GroundMotion.name gives the repr of from_arrays's station dict {"name": ...}
+    name = (station["name"] if isinstance(station, Mapping) and station.get("name")
+            and not (md.get("catalogue") or {}).get("id") else motion.name)
+    text = f"record {name}" + (f" ({site})" if site else "")
+    horizontal = str(md.get("horizontal") or "")
+    channels = md.get("channels") or {}
+    if horizontal in channels:
+        az = (md.get("azimuths") or {}).get(horizontal)
+        horizontal = f"{horizontal} = {channels[horizontal]}" + (
+            f" ({float(az):g} deg)" if az is not None else "")
+    if horizontal:
+        text += f": horizontal {horizontal}"
+    event = md.get("event") or {}
+    when = event.get("time") or ""
+    if when:
+        when = str(when).replace("T", " ")[:19] + " UTC"
+        magnitude = event.get("magnitude")
+        if magnitude is not None:
+            kind = str(event.get("magnitude_type") or "M")
+            kind = "Mw" if kind.lower() == "mw" else kind
+            when += f" {kind} {float(magnitude):.3g}"
+        text += f", event {when}"
+    elif motion.starttime.year > 1970:  # 1970-01-01: a start the file does not state
+        text += f", start {str(motion.starttime)[:19].replace('T', ' ')} UTC"
+    if isinstance(scale, str):
+        text += f", {scale}"
+    elif scale is not None:
+        text += f", scale factor {float(scale):.4g}"
+    return text
 
 
 def active_window(time, acc, events=(), margin=2.0, end=None):
@@ -122,22 +174,44 @@ def active_window(time, acc, events=(), margin=2.0, end=None):
     return max(time[0], t0 - margin), min(time[-1], t1 + 1.5 * margin)
 
 
-#: Slip starts and stops are drawn as lines only up to this many (see :func:`plot_response`).
-MAX_SLIP_EVENT_LINES = 40
+#: Longest line of a response figure's title [characters] (its font is wider than an axes
+#: title's).
+SUPTITLE_WIDTH = 140
+
+#: Slip starts and stops are drawn as lines only up to this many (see :func:`plot_response`):
+#: none by default, the mode bands show every slip episode and the legend counts them.
+MAX_SLIP_EVENT_LINES = 0
 #: Impacts likewise (a rocking episode has hundreds, mostly in its Zeno sequences).
 MAX_IMPACT_LINES = 40
 
 SLIP_EVENTS = ("ground_slip_start", "ground_slip_stop", "ship_slip_start", "ship_slip_stop")
 
 
+def _slip_summary(events) -> list[str]:
+    """Legend lines counting the slip episodes of each interface (their starts)."""
+    out = []
+    for start, stop, what in (("ground_slip_start", "ground_slip_stop", "blocks on the floor"),
+                              ("ship_slip_start", "ship_slip_stop", "ship on the blocks")):
+        n_start = sum(e.kind == start for e in events)
+        n_stop = sum(e.kind == stop for e in events)
+        if n_start or n_stop:
+            out.append(f"{what}: {n_start} slip starts, {n_stop} stops (see the mode bands)")
+    return out
+
+
 def plot_response(result, axes=None, max_event_lines=MAX_IMPACT_LINES, window="auto",
-                  max_slip_event_lines=MAX_SLIP_EVENT_LINES):
+                  max_slip_event_lines=MAX_SLIP_EVENT_LINES, record=None):
     """Response history: ground acceleration, block slip, rotation, ship slip, modes, events.
+
+    The title names the record (``record``, e.g. from :func:`record_text`: station, component,
+    event, scale factor), the system (:func:`system_text`) and the outcome (failure or none,
+    peaks); the time axis label says which window is shown when it is not the whole record.
 
     Parameters
     ----------
     result : SimulationResult or xarray.Dataset
-        The simulation to draw (or its :meth:`~SimulationResult.to_dataset`).
+        The simulation to draw (or its :meth:`~SimulationResult.to_dataset`; its attribute
+        ``record_description``, else ``record``, is the record line).
     axes : sequence of 4 matplotlib Axes, optional
         Panels for ground acceleration, x_b, theta and x_s; a new figure when None.
     max_event_lines : int, optional
@@ -145,11 +219,14 @@ def plot_response(result, axes=None, max_event_lines=MAX_IMPACT_LINES, window="a
         hundreds (mostly in the Zeno sequences that end it), whose lines would hide the curves;
         the rotation's zero crossings show them as well (the legend gives their number).
     max_slip_event_lines : int, optional
-        Draw slip starts and stops as lines only if there are at most this many: a stick-slip
-        record has hundreds, whose lines would hide the curves, and the mode bands show the
-        same (the legend gives their number).
+        Draw slip starts and stops as lines only if there are at most this many (default
+        none): the mode bands show each slip episode already, and the legend counts the starts
+        and stops per interface.
     window : "auto", None or (t0, t1), optional
-        Time axis limits [s]; "auto" shows 1-99 % of the Arias intensity and every event.
+        Time axis limits [s]; "auto" shows 1-99 % of the Arias intensity and every event (up to
+        a failure), with 2 s before and 3 s after; None the whole record.
+    record : str, optional
+        The record line of the title (default: the dataset's, or none for a result).
 
     Returns
     -------
@@ -158,6 +235,7 @@ def plot_response(result, axes=None, max_event_lines=MAX_IMPACT_LINES, window="a
     """
     if hasattr(result, "data_vars"):
         result = _DatasetResponse(result)
+        record = record or result.record
     if axes is None:
         fig, axes = _new_axes(4)
     else:
@@ -174,7 +252,8 @@ def plot_response(result, axes=None, max_event_lines=MAX_IMPACT_LINES, window="a
     ax_g.legend(loc="upper right", fontsize=8, ncol=2)
     ax_b.plot(t, 100 * result.x_b, color="tab:blue", lw=1.0)
     ax_b.set_ylabel("block slip $x_b$ [cm]")
-    theta_c = result.system.critical_angle
+    system = result.system
+    theta_c = system["critical_angle"] if isinstance(system, Mapping) else system.critical_angle
     ax_t.plot(t, 1000 * result.theta, color="tab:orange", lw=1.0)
     ax_t.set_ylabel(r"rotation $\theta$ [mrad]")
     peak = np.nanmax(np.abs(result.theta)) if np.isfinite(result.theta).any() else 0.0
@@ -186,7 +265,6 @@ def plot_response(result, axes=None, max_event_lines=MAX_IMPACT_LINES, window="a
                   va="bottom", fontsize=8, transform=ax_t.get_yaxis_transform())
     ax_s.plot(t, 100 * result.x_s, color="tab:green", lw=1.0)
     ax_s.set_ylabel("ship slip $x_s$ [cm]")
-    ax_s.set_xlabel("time [s]")
     # modes as coloured bands behind every panel
     spans = mode_spans(t, result.mode)
     seen = set()
@@ -222,8 +300,8 @@ def plot_response(result, axes=None, max_event_lines=MAX_IMPACT_LINES, window="a
     kinds = {e.kind for e in result.events} - {"start"}
     if not draw_slips:
         kinds -= set(SLIP_EVENTS)
-        handles.append(Patch(facecolor="none", edgecolor="none",
-                             label=f"{n_slip} slip starts and stops: see the mode bands"))
+        handles += [Patch(facecolor="none", edgecolor="none", label=line)
+                    for line in _slip_summary(result.events)]
     if not draw_impacts:
         kinds.discard("impact")
         # counted as the summary counts them: an impact that ends rocking is one too
@@ -236,15 +314,28 @@ def plot_response(result, axes=None, max_event_lines=MAX_IMPACT_LINES, window="a
                 if k in EVENT_STYLES]
     if handles:
         axes[3].legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.35),
-                       ncol=3, fontsize=7, frameon=False)
+                       ncol=3 if len(handles) > 4 else 2, fontsize=7, frameon=False)
+    xlabel = "time [s]"
+    shown = window
     if window == "auto":
-        window = active_window(t, a_h, result.events, end=result.failure_time)
-    if window is not None:
-        axes[0].set_xlim(*window)
-    title = "ship-block response"
-    if result.failure:
-        title += f": {result.failure} at t = {result.failure_time:.3f} s"
-    fig.suptitle(title)
+        shown = active_window(t, a_h, result.events, end=result.failure_time)
+    if shown is not None:
+        axes[0].set_xlim(*shown)
+        if shown[0] > t[0] or shown[1] < t[-1]:
+            why = ((": 1-99 % of the Arias intensity" + (" up to the failure" if result.failure
+                                                         else "") + " and every event, +2/3 s")
+                   if window == "auto" else "")
+            xlabel += (f"   (shown: {shown[0]:.1f} to {shown[1]:.1f} s of the record's "
+                       f"{t[0]:.1f} to {t[-1]:.1f} s{why})")
+    ax_s.set_xlabel(xlabel, fontsize=8.5)
+    outcome = ("response: no failure" if not result.failure
+               else f"response: {result.failure} at t = {result.failure_time:.3f} s")
+    outcome += (f"; peaks |x_b| {100 * np.nanmax(np.abs(result.x_b)):.3g} cm, |theta| "
+                f"{1000 * peak:.3g} mrad, |x_s| {100 * np.nanmax(np.abs(result.x_s)):.3g} cm")
+    lines = [record] if record else []
+    lines += ["system: " + system_text(system), outcome]
+    fig.suptitle("\n".join(w for line in lines for w in textwrap.wrap(line, SUPTITLE_WIDTH)),
+                 fontsize=8.5)
     return axes
 
 
