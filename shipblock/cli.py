@@ -1,4 +1,4 @@
-"""The ``shipblock`` command: simulate, process, info, run, history, plot, bench.
+"""The ``shipblock`` command: simulate, process, info, run, history, plot, export, bench.
 
 The command only parses arguments, calls the library and prints; every computation lives in the
 library. User errors print one line ``shipblock: error: ...`` and exit with status 2.
@@ -599,6 +599,21 @@ def cmd_plot(args):
     return 0
 
 
+def cmd_export(args):
+    import xarray as xr
+
+    from shipblock.fragility.export import write_csv
+
+    with xr.open_dataset(args.results) as ds:
+        ds = ds.load()
+    if "median" not in ds or "limit_state" not in ds.dims:
+        raise UserError(f"{args.results}: not the result of a study ('shipblock run'); a "
+                        "simulation's response is drawn with 'shipblock plot'")
+    for path in write_csv(ds, args.csv):
+        sys.stdout.write(f"written {path}\n")
+    return 0
+
+
 def _check_edp(ds, edp, results):
     """Refuse an ``--edp`` the results do not hold, listing those they do (and the closest)."""
     import difflib
@@ -740,6 +755,16 @@ def build_parser():
                    help="with --kind median: the swept parameter on the x axis (default: the "
                         "first)")
     s.set_defaults(func=cmd_plot)
+
+    s = sub.add_parser("export", help="a study's results as CSV tables (runs, fragility)",
+                       description="Write the per-run table (runs.csv: EDPs, scale factors, "
+                       "failure, exceedance per limit state) and the fitted fragility table "
+                       "(fragility.csv: definition, median, bootstrap band, beta) of a results "
+                       "file of 'shipblock run'; every column of a quantity names its unit, "
+                       "e.g. 'peak_ship_slip [m]'.")
+    s.add_argument("results", help="NetCDF written by 'run'")
+    s.add_argument("--csv", required=True, metavar="DIR", help="folder for the CSV tables")
+    s.set_defaults(func=cmd_export)
 
     s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "
                                      "batch scaling")
