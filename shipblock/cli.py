@@ -184,7 +184,7 @@ def _processing_chain(spec):
     return chain
 
 
-def _load_motion(args):
+def _load_motion(args, process=True):
     from shipblock.motion import read_motion
     from shipblock.processing import process_motion
 
@@ -206,7 +206,7 @@ def _load_motion(args):
                              **_conversion_kwargs(args))
     else:
         raise UserError("no record: give record files or --record ID (see 'shipblock info --help')")
-    chain = _processing_chain(args.processing)
+    chain = _processing_chain(args.processing) if process else []
     if chain:
         motion = process_motion(motion, chain)
     return motion
@@ -462,7 +462,19 @@ def cmd_info(args):
               f"Sa(0.2 s) {sa[0] / STANDARD_GRAVITY:.4f} g, Sa(1 s) {sa[1] / STANDARD_GRAVITY:.4f} g\n")
     for note in md.get("processing", []) or []:
         out.write(f"processing  {note}\n")
+    if args.figure:
+        _record_figure(args, motion)
+        out.write(f"figure written to {args.figure}\n")
     return 0
+
+
+def _record_figure(args, processed):
+    """``info --figure``: the record as read and processed, spectra, Fourier amplitudes."""
+    from shipblock.plot_record import plot_record_overview
+
+    raw = _load_motion(args, process=False)
+    done = processed if processed.metadata.get("processing") else None
+    _save_figure(lambda: plot_record_overview(raw, done)["spectra"].figure, args.figure)
 
 
 def cmd_catalogue(args):
@@ -695,6 +707,10 @@ def build_parser():
 
     s = sub.add_parser("info", help="what is in a record: components, units, sampling, IMs")
     _add_record_arguments(s)
+    s.add_argument("--figure", metavar="PNG",
+                   help="draw the record: each component as read and processed (the file's "
+                        "stated peak marked), 5 %%-damped response spectra with the RotD50 of "
+                        "the horizontals, and Fourier amplitude spectra")
     s.set_defaults(func=cmd_info)
 
     s = sub.add_parser("process", help="process records; write MiniSEED/SAC and an IM table")
