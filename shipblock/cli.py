@@ -470,7 +470,7 @@ def cmd_info(args):
 
 def _record_figure(args, processed):
     """``info --figure``: the record as read and processed, spectra, Fourier amplitudes."""
-    from shipblock.plot_record import plot_record_overview
+    from shipblock.plot import plot_record_overview
 
     raw = _load_motion(args, process=False)
     done = processed if processed.metadata.get("processing") else None

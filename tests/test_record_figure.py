@@ -12,7 +12,7 @@ from shipblock.cli import main
 from shipblock.errors import ParameterError
 from shipblock.intensity import response_spectrum
 from shipblock.motion import GroundMotion
-from shipblock.plot_record import plot_record_overview, stated_peaks
+from shipblock.plot import plot_record_overview, stated_peaks
 from shipblock.rotd import ANGLES_DEG, rotd_spectrum
 from shipblock.units import STANDARD_GRAVITY as G
 

@@ -10,13 +10,12 @@ spectra of the processed components with the RotD50 of the two horizontals
 from __future__ import annotations
 
 import re
-import textwrap
 
 import numpy as np
 
 from shipblock import intensity
 from shipblock.motion import COMPONENT_KEY
-from shipblock.plot import SUPTITLE_WIDTH, active_window, record_text
+from shipblock.plot._common import SUPTITLE_WIDTH, active_window, record_text, wrapped
 from shipblock.rotd import rotd_spectrum
 from shipblock.units import STANDARD_GRAVITY
 
@@ -146,6 +145,5 @@ def plot_record_overview(raw, processed=None, periods=None, damping=0.05):
         lines.append("processed: " + ", ".join(steps) + " (the list: shipblock info)")
     if stated:
         lines.append("red dashed: the peak the file itself states")
-    fig.suptitle("\n".join(w for line in lines for w in textwrap.wrap(line, SUPTITLE_WIDTH)),
-                 fontsize=8.5)
+    fig.suptitle(wrapped(lines, SUPTITLE_WIDTH), fontsize=8.5)
     return axes
