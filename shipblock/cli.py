@@ -221,31 +221,9 @@ def _system_from_args(args):
     return system.replace(**changes) if changes else system
 
 
-def _target_pga(text: str) -> float:
-    """``--target-pga`` as m/s^2: a number with its unit (``0.4g``, ``3.9 m/s^2``, ``392gal``)."""
-    import re
-
-    from shipblock.units import acceleration_to_si
-
-    match = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S*)\s*", text)
-    if match is None:
-        raise UserError(f"--target-pga {text!r}: expected a number and its unit, e.g. 0.4g")
-    value, unit = float(match.group(1)), match.group(2)
-    if not unit:
-        raise UserError(f"--target-pga {text}: give its unit, e.g. {text}g, {text}m/s^2 or "
-                        f"{text}gal (a bare number would be m/s^2)")
-    try:
-        target = float(acceleration_to_si(value, unit))
-    except ValueError as exc:
-        raise UserError(f"--target-pga {text}: {exc}") from None
-    if not target > 0:
-        raise UserError(f"--target-pga {text}: must be above zero")
-    return target
-
-
 def _scaled_input(args, motion):
     """The horizontal and vertical to simulate, and the scale phrase of the figure's title."""
-    from shipblock.scaling import scale_record
+    from shipblock.scaling import acceleration_target, scale_record
 
     vertical = None if args.no_vertical else motion.vertical
     if args.target_pga is None:
@@ -257,7 +235,7 @@ def _scaled_input(args, motion):
         return ax, ay, factor
     if args.scale is not None:
         raise UserError("give --scale or --target-pga, not both")
-    target = _target_pga(args.target_pga)
+    target = acceleration_target(args.target_pga, "--target-pga")
     options = {"target": target, "measure": "pga"}
     if vertical is not None and args.vertical_scale is not None:
         options.update(vertical_mode="independent", vertical_factor=args.vertical_scale)
@@ -373,6 +351,7 @@ def _parse_assignments(items):
 
 def cmd_history(args):
     from shipblock.fragility.pipeline import _rerun
+    from shipblock.plot import dataset_record_line, run_name
 
     if args.im_level is not None and args.im_level_g is not None:
         raise UserError("give --im-level or --im-level-g, not both")
@@ -381,12 +360,11 @@ def cmd_history(args):
     name = ds.attrs["record"]
     level = ""
     if "im_level" in ds.attrs:
-        level = f" at {_run_name(ds).rsplit(', ', 1)[-1]}"
+        level = f" at {run_name(ds).rsplit(', ', 1)[-1]}"
     sys.stdout.write(f"run {ds.attrs['case']} of {args.pipeline}: {name}{level}, scale factor "
                      f"{ds.attrs['scale_factor']:.4g}\n")
     _report(res, name, args.events)
-    record = (f"record {_run_name(ds)}, scale factor {ds.attrs['scale_factor']:.4g}: run "
-              f"{ds.attrs['case']} of {args.pipeline}")
+    record = f"{dataset_record_line(ds)}: run {ds.attrs['case']} of {args.pipeline}"
     ds.attrs["record_description"] = record
     if args.output:
         _write_response(ds, args.output)
@@ -394,23 +372,9 @@ def cmd_history(args):
     return 0
 
 
-def _run_name(ds):
-    """Title of a saved response: its record and, for a run of a batch, its IM level."""
-    name = ds.attrs.get("record", "")
-    if name and "im_level" in ds.attrs:
-        value, unit = float(ds.attrs["im_level"]), ds.attrs.get("im_units", "")
-        if "im_display_units" in ds.attrs:  # the unit the pipeline gave its levels in
-            value /= float(ds.attrs["im_display_factor"])
-            unit = ds.attrs["im_display_units"]
-        elif unit == "m/s^2":
-            value, unit = value / STANDARD_GRAVITY, "g"
-        measure = ds.attrs.get("im_measure", "IM").upper().replace("SA", "Sa")
-        name += f", {measure} {value:.3g} {unit}"
-    return name
-
-
 def _response_figure(res, record):
-    """The response figure, ``record`` the first line of its title (:func:`plot_response`)."""
+    """The response figure, ``record`` the first line of its title (:func:`plot_response`;
+    None: a response dataset's own)."""
     from shipblock.plot import plot_response
 
     return plot_response(res, record=record)[0].figure
@@ -580,22 +544,28 @@ def cmd_plot(args):
         ds = ds.load()
     figure = args.figure or str(Path(args.results).with_suffix(".png"))
     if "x_b" in ds and "time" in ds.dims:
-        record = ds.attrs.get("record_description") or (
-            f"record {_run_name(ds)}" + (f", scale factor {float(ds.attrs['scale_factor']):.4g}"
-                                         if "scale_factor" in ds.attrs else ""))
-        _save_figure(lambda: _response_figure(ds, record), figure)
+        _save_figure(lambda: _response_figure(ds, None), figure)  # the file's own record line
         sys.stdout.write(f"figure written to {figure}\n")
         return 0
     if "median" not in ds:
         raise UserError(f"{args.results}: neither a simulation response nor a fragility result")
-    from shipblock.plot import plot_fragility, plot_ida, plot_median_sweep, sweep_selection
+    from shipblock.plot import (
+        check_edp,
+        plot_fragility,
+        plot_ida,
+        plot_median_sweep,
+        sweep_selection,
+    )
 
     try:
         sweep = sweep_selection(ds, _parse_assignments(args.set))
     except ValueError as exc:
         raise UserError(f"{args.results}: --set {exc}") from None
     if args.kind == "ida":
-        _check_edp(ds, args.edp, args.results)
+        try:
+            check_edp(ds, args.edp, "--edp")
+        except ValueError as exc:
+            raise UserError(f"{args.results}: {exc}") from None
         _save_figure(lambda: plot_ida(ds, args.edp, sweep=sweep).figure, figure)
     elif args.kind == "median":
         if not sweep:
@@ -624,22 +594,6 @@ def cmd_export(args):
     for path in write_csv(ds, args.csv):
         sys.stdout.write(f"written {path}\n")
     return 0
-
-
-def _check_edp(ds, edp, results):
-    """Refuse an ``--edp`` the results do not hold, listing those they do (and the closest)."""
-    import difflib
-
-    from shipblock.fragility.limit_states import EDP_VARIABLES
-
-    valid = [k for k, info in EDP_VARIABLES.items()
-             if k in ds and info.kind in ("float", "count")]
-    if edp in valid:
-        return
-    close = difflib.get_close_matches(edp, valid, n=1)
-    raise UserError(f"{results}: --edp {edp!r} is not a demand parameter of these results"
-                    + (f" (did you mean {close[0]!r}?)" if close else "")
-                    + f"; valid: {', '.join(valid)}")
 
 
 def cmd_bench(args):

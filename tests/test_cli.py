@@ -175,10 +175,8 @@ def test_response_figure_summarises_slip_events_and_draws_lines_only_when_asked(
     assert vertical_lines(many) == 0
     labels = [txt.get_text() for txt in many[3].get_legend().get_texts()]
     starts = sum(e.kind == "ground_slip_start" for e in res.events)
-    stops = sum(e.kind == "ground_slip_stop" for e in res.events)
-    assert starts + stops == n_slip  # mu_ship 0.6: the ship holds, only the blocks slide
-    assert f"blocks on the floor: {starts} slip starts, {stops} stops (see the mode bands)" \
-        in labels
+    assert starts > 0 and not any(e.kind == "ship_slip_start" for e in res.events)
+    assert f"blocks on the floor: {starts} slip starts (see the mode bands)" in labels
     assert not any("ship on the blocks" in label for label in labels)
     few = plot_response(res, max_slip_event_lines=n_slip)
     assert vertical_lines(few) == 3 * n_slip  # one line per event in each of three panels

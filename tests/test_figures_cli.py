@@ -102,3 +102,17 @@ def test_plot_edp_typo_lists_the_valid_names(tmp_path, capsys):
     code, _, err = run(capsys, "plot", str(nc), "--kind", "ida", "--edp", "residual_ship_slip",
                        "-o", str(tmp_path / "x.png"))
     assert code == 0, err
+
+
+def test_acceleration_target_reads_a_number_with_its_unit():
+    from shipblock.errors import ParameterError
+    from shipblock.scaling import acceleration_target
+
+    assert acceleration_target("0.4g") == pytest.approx(0.4 * G, rel=1e-15)
+    assert acceleration_target(" 392 gal ") == pytest.approx(3.92, rel=1e-15)
+    assert acceleration_target("3.9m/s^2") == 3.9
+    assert acceleration_target("1e-1 g") == pytest.approx(0.1 * G, rel=1e-15)
+    for text, needle in (("0.4", "target 0.4: give its unit"), ("g", "a number and its unit"),
+                         ("-0.4g", "positive"), ("0.4 furlongs", "unknown acceleration unit")):
+        with pytest.raises(ParameterError, match=needle):
+            acceleration_target(text)

@@ -82,7 +82,34 @@ class _DatasetResponse:
         self.system["critical_angle"] = math.atan2(float(ds.attrs["system_half_width"]),
                                                    float(ds.attrs["system_half_height"]))
         #: the record line of the title (written by ``shipblock simulate`` and ``history``)
-        self.record = str(ds.attrs.get("record_description", ds.attrs.get("record", "")))
+        self.record = str(ds.attrs.get("record_description") or dataset_record_line(ds))
+
+
+def run_name(ds) -> str:
+    """A saved response's record and, for a run of a batch, its IM level (``"NP.1765, PGA
+    0.8 g"``, in the unit the pipeline gave its levels in)."""
+    name = str(ds.attrs.get("record", ""))
+    if name and "im_level" in ds.attrs:
+        value, unit = float(ds.attrs["im_level"]), ds.attrs.get("im_units", "")
+        if "im_display_units" in ds.attrs:  # the unit the pipeline gave its levels in
+            value /= float(ds.attrs["im_display_factor"])
+            unit = ds.attrs["im_display_units"]
+        elif unit == "m/s^2":
+            value, unit = value / STANDARD_GRAVITY, "g"
+        measure = ds.attrs.get("im_measure", "IM").upper().replace("SA", "Sa")
+        name += f", {measure} {value:.3g} {unit}"
+    return name
+
+
+def dataset_record_line(ds) -> str:
+    """The record line of a saved response without one of its own (a batch's history file):
+    ``"record NP.1765, PGA 0.8 g, scale factor 3.1"``; empty if the file names no record."""
+    name = run_name(ds)
+    if not name:
+        return ""
+    scale = (f", scale factor {float(ds.attrs['scale_factor']):.4g}"
+             if "scale_factor" in ds.attrs else "")
+    return f"record {name}{scale}"
 
 
 #: Slip starts and stops are drawn as lines only up to this many (see :func:`plot_response`):
@@ -95,14 +122,14 @@ SLIP_EVENTS = ("ground_slip_start", "ground_slip_stop", "ship_slip_start", "ship
 
 
 def _slip_summary(events) -> list[str]:
-    """Legend lines counting the slip episodes of each interface (their starts)."""
+    """Legend lines counting the slip episodes of each interface (their starts; a stop may
+    also end a slip that another event began, so stops are not counted)."""
     out = []
-    for start, stop, what in (("ground_slip_start", "ground_slip_stop", "blocks on the floor"),
-                              ("ship_slip_start", "ship_slip_stop", "ship on the blocks")):
+    for start, what in (("ground_slip_start", "blocks on the floor"),
+                        ("ship_slip_start", "ship on the blocks")):
         n_start = sum(e.kind == start for e in events)
-        n_stop = sum(e.kind == stop for e in events)
-        if n_start or n_stop:
-            out.append(f"{what}: {n_start} slip starts, {n_stop} stops (see the mode bands)")
+        if n_start:
+            out.append(f"{what}: {n_start} slip starts (see the mode bands)")
     return out
 
 
@@ -127,8 +154,8 @@ def plot_response(result, axes=None, max_event_lines=MAX_IMPACT_LINES, window="a
         the rotation's zero crossings show them as well (the legend gives their number).
     max_slip_event_lines : int, optional
         Draw slip starts and stops as lines only if there are at most this many (default
-        none): the mode bands show each slip episode already, and the legend counts the starts
-        and stops per interface.
+        none): the mode bands show each slip episode already, and the legend counts the slip
+        starts per interface.
     window : "auto", None or (t0, t1), optional
         Time axis limits [s]; "auto" shows 1-99 % of the Arias intensity and every event (up to
         a failure), with 2 s before and 3 s after; None the whole record.

@@ -4,6 +4,7 @@ shows (:func:`study_caption`)."""
 
 from __future__ import annotations
 
+import difflib
 import json
 from pathlib import PurePath
 
@@ -11,6 +12,7 @@ import numpy as np
 
 from shipblock.errors import ParameterError
 from shipblock.fragility.design import apply_parameters
+from shipblock.fragility.limit_states import EDP_VARIABLES
 from shipblock.fragility.report import display_units, im_label
 from shipblock.plot._common import _new_axes, _title, system_text
 from shipblock.system import ShipBlockSystem
@@ -381,6 +383,23 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
     return ax
 
 
+def check_edp(ds, edp, name="edp") -> str:
+    """``edp`` if the results hold it as a numeric demand parameter, else a ParameterError
+    naming ``name`` (a keyword or a flag), the closest valid name and all of them.
+
+    The valid names are those of :data:`shipblock.fragility.limit_states.EDP_VARIABLES` of kind
+    float or count that the results hold.
+    """
+    valid = [k for k, info in EDP_VARIABLES.items()
+             if k in ds and info.kind in ("float", "count")]
+    if edp in valid:
+        return edp
+    close = difflib.get_close_matches(str(edp), valid, n=1)
+    raise ParameterError(f"{name} {edp!r} is not a demand parameter of these results"
+                         + (f" (did you mean {close[0]!r}?)" if close else "")
+                         + f"; valid: {', '.join(valid)}")
+
+
 def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
     """IDA curves: the demand ``edp`` of each record against the intensity it was scaled to.
 
@@ -392,7 +411,7 @@ def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
     ds : xarray.Dataset
         Result of :func:`shipblock.run_pipeline` of an IDA or MSA study.
     edp : str
-        The demand on the x axis.
+        The demand on the x axis (a ParameterError lists the valid names: :func:`check_edp`).
     ax : matplotlib Axes, optional
     sweep : dict, optional
         Value of each swept parameter to draw (default: the first of each); named in the title.
@@ -401,6 +420,7 @@ def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
     -------
     matplotlib.axes.Axes
     """
+    check_edp(ds, edp)
     if ax is None:
         _, axs = _new_axes(1, height=4.0)
         ax = axs[0]
