@@ -156,3 +156,20 @@ def test_plot_command_draws_the_swept_value_asked_for_and_the_median_against_the
     line = ax.get_lines()[0]
     np.testing.assert_allclose(line.get_ydata(),
                                ds["median"].sel(limit_state="ship_slip").values / G)
+
+
+def test_cloud_figure_draws_each_records_outcome_at_its_intensity(tmp_path):
+    path = write_pipeline(tmp_path, kind="cloud", levels="")
+    ds = run_pipeline(path, progress=False)
+    ax = plot_fragility(ds)
+    title = ax.get_title(loc="left")
+    assert "design: cloud on PGA, 3 records at their own intensity" in title
+    assert "records' outcome (1: exceeded, 0: not)" in title
+    markers = [ln for ln in ax.get_lines() if ln.get_linestyle() == "None"]
+    assert len(markers) == 2
+    np.testing.assert_allclose(markers[0].get_xdata(), ds["achieved_im"].values / G,
+                               rtol=1e-12)
+    np.testing.assert_array_equal(markers[0].get_ydata(),
+                                  ds["exceeded"].sel(limit_state="ship_slip").values)
+    fitted = np.isfinite(ds["median"].values).any()
+    assert ("lines: lognormal fit" in title) == bool(fitted)

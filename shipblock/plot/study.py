@@ -230,7 +230,7 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
     sizes = marker_sizes(len(names))
     n_per_level = None
     handles = []
-    band_drawn = False
+    band_drawn = any_fitted = False
     for i, name in enumerate(names):
         c = f"C{i % 10}"
         marker = _MARKERS[i % len(_MARKERS)]
@@ -243,9 +243,9 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
             desc += f": median {med_plot[0]:.3g} {display_units(ds)[0]}, beta {beta:.2f}"
         else:
             desc += ": no fit"
-        handles.append(Line2D([], [], color=c, lw=1.8 if fitted else 0,
-                              marker=marker if scaled else None, mfc="white", mew=1.5,
-                              ms=sizes[i], label=desc))
+        handles.append(Line2D([], [], color=c, lw=1.8 if fitted else 0, marker=marker,
+                              mfc="white", mew=1.5, ms=sizes[i], label=desc))
+        any_fitted = any_fitted or fitted
         if fitted:
             ax.plot(x_plot, norm.cdf(np.log(x_si / median) / beta), color=c, lw=1.8)
             if "median_lower" in ds:
@@ -267,12 +267,21 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
             xo, _, _ = _im_axis(ds, x_obs_si)
             # at the level itself; the first limit state's marker the largest (nested)
             ax.plot(xo, frac, marker, color=c, ms=sizes[i], mfc="none", mew=1.5, zorder=3 + i)
+        else:
+            # a cloud: each record's outcome (1 exceeded, 0 not) at the intensity it had
+            ex = _select_sweep(ds["exceeded"].sel(limit_state=name), sweep)
+            ok = _select_sweep(ds["valid"].sel(limit_state=name), sweep).values
+            im = _select_sweep(ds["achieved_im"], sweep).values
+            xo, _, _ = _im_axis(ds, im[ok])
+            ax.plot(xo, ex.values[ok].astype(float), marker, color=c, ms=sizes[i], mfc="none",
+                    mew=1.5, zorder=3 + i)
     ax.set_xlabel(xlabel)
     ax.set_ylabel("probability of exceedance")
     ax.set_ylim(-0.03, 1.03)
     ax.set_xlim(0, x_plot[-1])
     ax.grid(True, lw=0.3, alpha=0.5)
-    curves = "fragility: lines: lognormal fit"
+    curves = ("fragility: lines: lognormal fit" if any_fitted
+              else "fragility: no curve could be fitted (the legend says which)")
     if band_drawn:
         conf = ds["median_lower"].attrs.get("confidence")
         curves += ("; shaded: " + (f"{100 * float(conf):g} % " if conf is not None else "")
@@ -288,7 +297,8 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
                     "(not shifted; coinciding ones nest, largest first)")
     else:
         n_rec = int(ds["valid"].sel(limit_state=names[0]).pipe(_select_sweep, sweep).sum())
-        what.append(f"{n_rec} records at their own intensity (no fractions per level)")
+        what.append(f"markers: each of the {n_rec} records' outcome (1: exceeded, 0: not) at "
+                    "its own intensity (coinciding ones nest, largest first)")
     _title(ax, study_caption(ds, sweep), what)
     ax.legend(handles=handles, fontsize=7.5, loc="best")
     return ax
