@@ -492,6 +492,14 @@ def scale_motion(motion, **options):
         ``shipblock.scaling.scale_record(...)`` in every trace's ``stats.processing``.
     scaled : ScaledRecord
         The factors and achieved measures.
+
+    Examples
+    --------
+    The pair is unpacked; the motion is what :func:`shipblock.simulate` takes
+    (``simulate(system, scale_motion(gm, target=...)[0])``)::
+
+        scaled_motion, info = scale_motion(gm, target=0.4 * 9.80665)
+        result = simulate(system, scaled_motion)
     """
     from shipblock.motion import COMPONENT_KEY  # lazy: motion imports obspy
 

@@ -142,7 +142,7 @@ def plot_record_overview(raw, processed=None, periods=None, damping=0.05):
     notes = (processed.metadata.get("processing") or []) if processed is not None else []
     steps = [m for note in notes for m in re.findall(r"(\w+)\(", str(note))]
     if steps:
-        lines.append("processed: " + ", ".join(steps) + " (the list: shipblock info)")
+        lines.append("processed: " + ", ".join(steps) + " (their parameters: shipblock info)")
     if stated:
         lines.append("red dashed: the peak the file itself states")
     fig.suptitle(wrapped(lines, SUPTITLE_WIDTH), fontsize=8.5)
