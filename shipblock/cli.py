@@ -364,7 +364,7 @@ def cmd_history(args):
     sys.stdout.write(f"run {ds.attrs['case']} of {args.pipeline}: {name}{level}, scale factor "
                      f"{ds.attrs['scale_factor']:.4g}\n")
     _report(res, name, args.events)
-    record = f"{dataset_record_line(ds)}: run {ds.attrs['case']} of {args.pipeline}"
+    record = dataset_record_line(ds)
     ds.attrs["record_description"] = record
     if args.output:
         _write_response(ds, args.output)

@@ -116,3 +116,23 @@ def test_acceleration_target_reads_a_number_with_its_unit():
                          ("-0.4g", "positive"), ("0.4 furlongs", "unknown acceleration unit")):
         with pytest.raises(ParameterError, match=needle):
             acceleration_target(text)
+
+
+def test_a_batch_history_file_is_titled_with_its_record_level_and_run():
+    import json
+
+    from shipblock.plot import dataset_record_line
+
+    provenance = {"catalogue": {"id": "napa/NP.1765", "site": "Napa"}, "horizontal": "H1",
+                  "channels": {"H1": "NP.1765..HNN"}, "azimuths": {"H1": 0.0},
+                  "event": {"time": "2014-08-24T10:20:44.07Z", "magnitude": 6.02,
+                            "magnitude_type": "mw"}}
+    ds = xr.Dataset(attrs={"record": "napa/NP.1765", "record_provenance": json.dumps(provenance),
+                           "im_level": 0.8 * G, "im_units": "m/s^2", "im_measure": "pga",
+                           "scale_factor": 1.95, "case": 37,
+                           "pipeline_source": "pipelines/demo.toml"})
+    assert dataset_record_line(ds) == (
+        "record napa/NP.1765 (Napa): horizontal H1 = NP.1765..HNN (0 deg), event 2014-08-24 "
+        "10:20:44 UTC Mw 6.02, scaled to PGA 0.8 g, scale factor 1.95; run 37 of "
+        "pipelines/demo.toml")
+    assert dataset_record_line(xr.Dataset()) == ""

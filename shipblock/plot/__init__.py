@@ -23,6 +23,7 @@ from shipblock.plot._common import (
     SUPTITLE_WIDTH,
     TITLE_WIDTH,
     active_window,
+    record_line,
     record_text,
     system_text,
 )
@@ -79,6 +80,7 @@ __all__ = [
     "plot_record_overview",
     "plot_response",
     "plot_spectrum",
+    "record_line",
     "record_text",
     "run_name",
     "stated_peaks",

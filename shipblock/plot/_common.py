@@ -87,11 +87,20 @@ def record_text(motion, scale=None) -> str:
         (0 deg), event 2014-08-24 10:20:44 UTC Mw 6.02, scale factor 2.6"``.
     """
     md = motion.metadata
-    site = (md.get("catalogue") or {}).get("site", "")
     station = md.get("station")
     # GroundMotion.name gives the repr of from_arrays's station dict {"name": ...}
     name = (station["name"] if isinstance(station, Mapping) and station.get("name")
             and not (md.get("catalogue") or {}).get("id") else motion.name)
+    start = motion.starttime
+    start = str(start)[:19].replace("T", " ") if start.year > 1970 else None
+    return record_line(name, md, start, scale)
+
+
+def record_line(name, metadata, start=None, scale=None) -> str:
+    """:func:`record_text` from a record's name and metadata (e.g. the provenance a batch's
+    history file keeps); ``start`` the first sample's time as text when the file states it."""
+    md = metadata
+    site = (md.get("catalogue") or {}).get("site", "")
     text = f"record {name}" + (f" ({site})" if site else "")
     horizontal = str(md.get("horizontal") or "")
     channels = md.get("channels") or {}
@@ -111,8 +120,8 @@ def record_text(motion, scale=None) -> str:
             kind = "Mw" if kind.lower() == "mw" else kind
             when += f" {kind} {float(magnitude):.3g}"
         text += f", event {when}"
-    elif motion.starttime.year > 1970:  # 1970-01-01: a start the file does not state
-        text += f", start {str(motion.starttime)[:19].replace('T', ' ')} UTC"
+    elif start:  # 1970-01-01 is a start the file does not state: the caller leaves it out
+        text += f", start {start} UTC"
     if isinstance(scale, str):
         text += f", {scale}"
     elif scale is not None:

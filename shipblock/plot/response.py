@@ -4,6 +4,7 @@ velocity and displacement (:func:`plot_record`) and its response spectrum
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping
 
@@ -14,6 +15,7 @@ from shipblock.plot._common import (
     SUPTITLE_WIDTH,
     _new_axes,
     active_window,
+    record_line,
     system_text,
     wrapped,
 )
@@ -103,13 +105,24 @@ def run_name(ds) -> str:
 
 def dataset_record_line(ds) -> str:
     """The record line of a saved response without one of its own (a batch's history file):
-    ``"record NP.1765, PGA 0.8 g, scale factor 3.1"``; empty if the file names no record."""
-    name = run_name(ds)
-    if not name:
+    the record (:func:`record_line` of its kept provenance) at its IM level, the scale factor and
+    the run of the pipeline; empty if the file names no record."""
+    record = str(ds.attrs.get("record", ""))
+    if not record:
         return ""
-    scale = (f", scale factor {float(ds.attrs['scale_factor']):.4g}"
-             if "scale_factor" in ds.attrs else "")
-    return f"record {name}{scale}"
+    try:
+        metadata = json.loads(ds.attrs.get("record_provenance", "{}"))
+    except ValueError:
+        metadata = {}
+    level = run_name(ds)[len(record) + 2:]  # "PGA 0.8 g" for a run of a batch
+    scale = [f"scaled to {level}"] if level else []
+    if "scale_factor" in ds.attrs:
+        scale.append(f"scale factor {float(ds.attrs['scale_factor']):.4g}")
+    text = record_line(record, metadata if isinstance(metadata, dict) else {},
+                       scale=", ".join(scale) or None)
+    if "pipeline_source" in ds.attrs and "case" in ds.attrs:
+        text += f"; run {ds.attrs['case']} of {ds.attrs['pipeline_source']}"
+    return text
 
 
 #: Slip starts and stops are drawn as lines only up to this many (see :func:`plot_response`):
