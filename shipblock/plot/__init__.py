@@ -19,6 +19,8 @@ whole record.
 
 from __future__ import annotations
 
+import importlib
+
 from shipblock.plot._common import (
     SUPTITLE_WIDTH,
     TITLE_WIDTH,
@@ -41,19 +43,22 @@ from shipblock.plot.response import (
     plot_spectrum,
     run_name,
 )
-from shipblock.plot.study import (
-    DODGE,
-    MARKER_SIZE,
-    MARKER_STEP,
-    check_edp,
-    limit_state_text,
-    marker_sizes,
-    plot_fragility,
-    plot_ida,
-    plot_median_sweep,
-    study_caption,
-    sweep_selection,
-)
+# The study figures load on first use: shipblock.fragility imports the solver, which a command
+# that draws a response or a record must not import (nor compile).
+_STUDY = ("DODGE", "MARKER_SIZE", "MARKER_STEP", "check_edp", "limit_state_text", "marker_sizes",
+          "plot_fragility", "plot_ida", "plot_median_sweep", "study_caption", "sweep_selection")
+
+
+def __getattr__(name):
+    if name in _STUDY:
+        return getattr(importlib.import_module("shipblock.plot.study"), name)
+    raise AttributeError(f"module 'shipblock.plot' has no attribute {name!r}")
+
+
+def __dir__():
+    """The names loaded so far and the study figures' (loaded on first use)."""
+    return sorted(set(globals()) | set(_STUDY))
+
 
 __all__ = [
     "DODGE",
