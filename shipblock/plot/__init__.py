@@ -46,7 +46,8 @@ from shipblock.plot.response import (
 # The study figures load on first use: shipblock.fragility imports the solver, which a command
 # that draws a response or a record must not import (nor compile).
 _STUDY = ("DODGE", "MARKER_SIZE", "MARKER_STEP", "check_edp", "limit_state_text", "marker_sizes",
-          "plot_fragility", "plot_ida", "plot_median_sweep", "study_caption", "sweep_selection")
+          "plot_fragility", "plot_ida", "plot_median_sweep", "study_caption", "sweep_selection",
+          "sweep_text")
 
 
 def __getattr__(name):
@@ -91,5 +92,6 @@ __all__ = [
     "stated_peaks",
     "study_caption",
     "sweep_selection",
+    "sweep_text",
     "system_text",
 ]

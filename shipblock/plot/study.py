@@ -134,7 +134,8 @@ def _select_sweep(da, sweep):
     return da
 
 
-def _sweep_text(sweep) -> str:
+def sweep_text(sweep) -> str:
+    """``"mu_ground = 0.5, n_blocks = 100"``: the swept values drawn, for titles."""
     return ", ".join(f"{k} = {v:g}" if isinstance(v, float | int | np.number) else f"{k} = {v}"
                      for k, v in (sweep or {}).items())
 
@@ -287,7 +288,7 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
         curves += ("; shaded: " + (f"{100 * float(conf):g} % " if conf is not None else "")
                    + "bootstrap band of the median")
     if sweep:
-        curves += f"; drawn at {_sweep_text(sweep)}"
+        curves += f"; drawn at {sweep_text(sweep)}"
     what = [curves]
     if n_per_level is not None:
         counts = np.unique(n_per_level)
@@ -384,7 +385,7 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
         what += (f"; limit states side by side, {100 * DODGE:g} % of the {parameter} range "
                  "apart")
     if others:
-        what += f"; drawn at {_sweep_text(others)}"
+        what += f"; drawn at {sweep_text(others)}"
     # the system line holds the base value of the parameter on the x axis: say it is swept
     caption = [line + (f"; {parameter} swept (x axis)" if line.startswith("system: ") else "")
                for line in study_caption(ds, others)]
@@ -457,7 +458,7 @@ def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
             f"intensity it was scaled to; x: failure (separation, overturning), drawn at the "
             f"right edge")
     if sweep:
-        what += f"; drawn at {_sweep_text(sweep)}"
+        what += f"; drawn at {sweep_text(sweep)}"
     _title(ax, study_caption(ds, sweep), [what])
     ax.legend(fontsize=8, ncol=2)
     return ax
