@@ -48,6 +48,11 @@ def __getattr__(name):
     return mod if module.endswith("." + name) else getattr(mod, name)
 
 
+def __dir__():
+    """The names loaded so far and those loaded on first use (``dir(shipblock)``, completion)."""
+    return sorted(set(globals()) | set(_LAZY))
+
+
 __all__ = [
     "ShipBlockSystem",
     "simulate",

@@ -1,4 +1,5 @@
-"""The ``shipblock`` command: simulate, process, info, catalogue, run, history, plot, risk, select, bench.
+"""The ``shipblock`` command: simulate, process, info, catalogue, run, history, plot, export, risk,
+select, bench.
 
 The command only parses arguments, calls the library and prints; every computation lives in the
 library. User errors print one line ``shipblock: error: ...`` and exit with status 2.
@@ -50,6 +51,9 @@ COMPILED_PARTS = (
     ("shipblock.impact", "the solver", 22.0),
     ("shipblock.interface_forces", "the contact loads", 0.5),
     ("shipblock.intensity", "the intensity measures", 0.3),
+    # RotD spectra (info --figure): compiled as fast as the spectrum kernel (4.3 s against its
+    # 4.9 s side by side on the loaded machine), so its time is quoted
+    ("shipblock.rotd", "the intensity measures", 0.3),
 )
 
 
@@ -188,7 +192,7 @@ def _processing_chain(spec):
     return chain
 
 
-def _load_motion(args):
+def _load_motion(args, process=True):
     from shipblock.records.reading import read_motion
     from shipblock.processing import process_motion
 
@@ -210,7 +214,7 @@ def _load_motion(args):
                              **_conversion_kwargs(args))
     else:
         raise UserError("no record: give record files or --record ID (see 'shipblock info --help')")
-    chain = _processing_chain(args.processing)
+    chain = _processing_chain(args.processing) if process else []
     if chain:
         motion = process_motion(motion, chain)
     return motion
@@ -225,25 +229,50 @@ def _system_from_args(args):
     return system.replace(**changes) if changes else system
 
 
+def _scaled_input(args, motion):
+    """The horizontal and vertical to simulate, and the scale phrase of the figure's title."""
+    from shipblock.scaling import acceleration_target, scale_record
+
+    vertical = None if args.no_vertical else motion.vertical
+    if args.target_pga is None:
+        factor = 1.0 if args.scale is None else args.scale
+        ax = motion.horizontal * factor
+        ay = None
+        if vertical is not None:
+            ay = vertical * (factor if args.vertical_scale is None else args.vertical_scale)
+        return ax, ay, factor
+    if args.scale is not None:
+        raise UserError("give --scale or --target-pga, not both")
+    target = acceleration_target(args.target_pga, "--target-pga")
+    options = {"target": target, "measure": "pga"}
+    if vertical is not None and args.vertical_scale is not None:
+        options.update(vertical_mode="independent", vertical_factor=args.vertical_scale)
+    scaled = scale_record(motion.horizontal, vertical, motion.dt, **options)
+    log.info("scaled to PGA %.4g g: factor %.4g on the horizontal%s", target / STANDARD_GRAVITY,
+             scaled.factor_h, "" if vertical is None else f", {scaled.factor_v:.4g} on the vertical")
+    return (scaled.horizontal, scaled.vertical,
+            f"scaled to PGA {target / STANDARD_GRAVITY:.3g} g (factor {scaled.factor_h:.4g})")
+
+
 def cmd_simulate(args):
+    from shipblock.plot import record_text
     from shipblock.solver import simulate
 
     system = _system_from_args(args)
     motion = _load_motion(args)
-    ax = motion.horizontal * args.scale
-    ay = None
-    if motion.vertical is not None and not args.no_vertical:
-        ay = motion.vertical * (args.scale if args.vertical_scale is None else args.vertical_scale)
+    ax, ay, scale = _scaled_input(args, motion)
     log.info("simulating %d samples at dt = %g s", ax.size, motion.dt)
     res = simulate(system, ax, ay, motion.dt, rtol=args.rtol)
     name = motion.name
+    record = record_text(motion, scale)
     _report(res, name, args.events)
     if args.output:
         ds = res.to_dataset()
         ds.attrs["record"] = str(name)
+        ds.attrs["record_description"] = record
         ds.attrs["processing"] = "\n".join(motion.metadata.get("processing", []) or [])
         _write_response(ds, args.output)
-    _response_figure_option(res, name, args.figure, args.output)
+    _response_figure_option(res, record, args.figure, args.output)
     return 0
 
 
@@ -254,11 +283,11 @@ def _write_response(ds, output):
     sys.stdout.write(f"response written to {output}\n")
 
 
-def _response_figure_option(res, name, figure, output):
+def _response_figure_option(res, record, figure, output):
     if figure is None and output:
         figure = str(Path(output).with_suffix(".png"))
     if figure:
-        _save_figure(lambda: _response_figure(res, name), figure)
+        _save_figure(lambda: _response_figure(res, record), figure)
         sys.stdout.write(f"figure written to {figure}\n")
 
 
@@ -330,6 +359,7 @@ def _parse_assignments(items):
 
 def cmd_history(args):
     from shipblock.fragility.pipeline import _rerun
+    from shipblock.plot import dataset_record_line, run_name
 
     if args.im_level is not None and args.im_level_g is not None:
         raise UserError("give --im-level or --im-level-g, not both")
@@ -338,38 +368,24 @@ def cmd_history(args):
     name = ds.attrs["record"]
     level = ""
     if "im_level" in ds.attrs:
-        level = f" at {_run_name(ds).rsplit(', ', 1)[-1]}"
+        level = f" at {run_name(ds).rsplit(', ', 1)[-1]}"
     sys.stdout.write(f"run {ds.attrs['case']} of {args.pipeline}: {name}{level}, scale factor "
                      f"{ds.attrs['scale_factor']:.4g}\n")
     _report(res, name, args.events)
+    record = dataset_record_line(ds)
+    ds.attrs["record_description"] = record
     if args.output:
         _write_response(ds, args.output)
-    _response_figure_option(res, name, args.figure, args.output)
+    _response_figure_option(res, record, args.figure, args.output)
     return 0
 
 
-def _run_name(ds):
-    """Title of a saved response: its record and, for a run of a batch, its IM level."""
-    name = ds.attrs.get("record", "")
-    if name and "im_level" in ds.attrs:
-        value, unit = float(ds.attrs["im_level"]), ds.attrs.get("im_units", "")
-        if "im_display_units" in ds.attrs:  # the unit the pipeline gave its levels in
-            value /= float(ds.attrs["im_display_factor"])
-            unit = ds.attrs["im_display_units"]
-        elif unit == "m/s^2":
-            value, unit = value / STANDARD_GRAVITY, "g"
-        measure = ds.attrs.get("im_measure", "IM").upper().replace("SA", "Sa")
-        name += f", {measure} {value:.3g} {unit}"
-    return name
-
-
-def _response_figure(res, name):
+def _response_figure(res, record):
+    """The response figure, ``record`` the first line of its title (:func:`plot_response`;
+    None: a response dataset's own)."""
     from shipblock.plot import plot_response
 
-    axes = plot_response(res)
-    if name:
-        axes[0].figure.suptitle(f"{name}: " + axes[0].figure._suptitle.get_text())
-    return axes[0].figure
+    return plot_response(res, record=record)[0].figure
 
 
 def _save_figure(make, path):
@@ -418,7 +434,19 @@ def cmd_info(args):
               f"Sa(0.2 s) {sa[0] / STANDARD_GRAVITY:.4f} g, Sa(1 s) {sa[1] / STANDARD_GRAVITY:.4f} g\n")
     for note in md.get("processing", []) or []:
         out.write(f"processing  {note}\n")
+    if args.figure:
+        _record_figure(args, motion)
+        out.write(f"figure written to {args.figure}\n")
     return 0
+
+
+def _record_figure(args, processed):
+    """``info --figure``: the record as read and processed, spectra, Fourier amplitudes."""
+    from shipblock.plot import plot_record_overview
+
+    raw = _load_motion(args, process=False)
+    done = processed if processed.metadata.get("processing") else None
+    _save_figure(lambda: plot_record_overview(raw, done)["spectra"].figure, args.figure)
 
 
 def cmd_catalogue(args):
@@ -527,20 +555,28 @@ def cmd_plot(args):
         ds = ds.load()
     figure = args.figure or str(Path(args.results).with_suffix(".png"))
     if "x_b" in ds and "time" in ds.dims:
-        _save_figure(lambda: _response_figure(ds, _run_name(ds)), figure)
+        _save_figure(lambda: _response_figure(ds, None), figure)  # the file's own record line
         sys.stdout.write(f"figure written to {figure}\n")
         return 0
     if "median" not in ds:
         raise UserError(f"{args.results}: neither a simulation response nor a fragility result")
-    from shipblock.plot import plot_fragility, plot_ida, plot_median_sweep, sweep_selection
+    from shipblock.plot import (
+        check_edp,
+        plot_fragility,
+        plot_ida,
+        plot_median_sweep,
+        sweep_selection,
+    )
 
     try:
         sweep = sweep_selection(ds, _parse_assignments(args.set))
     except ValueError as exc:
         raise UserError(f"{args.results}: --set {exc}") from None
     if args.kind == "ida":
-        if args.edp not in ds:
-            raise UserError(f"{args.results}: no demand parameter {args.edp!r}")
+        try:
+            check_edp(ds, args.edp, "--edp")
+        except ValueError as exc:
+            raise UserError(f"{args.results}: {exc}") from None
         _save_figure(lambda: plot_ida(ds, args.edp, sweep=sweep).figure, figure)
     elif args.kind == "median":
         if not sweep:
@@ -608,6 +644,21 @@ def cmd_select(args):
     return 0
 
 
+def cmd_export(args):
+    import xarray as xr
+
+    from shipblock.fragility.export import write_csv
+
+    with xr.open_dataset(args.results) as ds:
+        ds = ds.load()
+    if "median" not in ds or "limit_state" not in ds.dims:
+        raise UserError(f"{args.results}: not the result of a study ('shipblock run'); a "
+                        "simulation's response is drawn with 'shipblock plot'")
+    for path in write_csv(ds, args.csv):
+        sys.stdout.write(f"written {path}\n")
+    return 0
+
+
 def cmd_bench(args):
     if args.read:
         import json
@@ -661,7 +712,11 @@ def build_parser():
     for key, (flag, typ, help_) in SYSTEM_FLAGS.items():
         g.add_argument(flag, dest=key, type=typ, help=help_)
     g = s.add_argument_group("run")
-    g.add_argument("--scale", type=float, default=1.0, help="factor on the horizontal (and vertical)")
+    g.add_argument("--scale", type=float,
+                   help="factor on the horizontal (and vertical); default 1")
+    g.add_argument("--target-pga", metavar="PGA",
+                   help="scale to this PGA of the horizontal, with its unit: 0.4g, 3.9m/s^2, "
+                        "392gal (the vertical by the same factor unless --vertical-scale)")
     g.add_argument("--vertical-scale", type=float, help="independent factor on the vertical")
     g.add_argument("--no-vertical", action="store_true", help="ignore the vertical component")
     g.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of rocking phases")
@@ -672,6 +727,10 @@ def build_parser():
 
     s = sub.add_parser("info", help="what is in a record: components, units, sampling, IMs")
     _add_record_arguments(s)
+    s.add_argument("--figure", metavar="PNG",
+                   help="draw the record: each component as read and processed (the file's "
+                        "stated peak marked), 5 %%-damped response spectra with the RotD50 of "
+                        "the horizontals, and Fourier amplitude spectra")
     s.set_defaults(func=cmd_info)
 
     s = sub.add_parser("process", help="process records; write MiniSEED/SAC and an IM table")
@@ -793,6 +852,16 @@ def build_parser():
     s.add_argument("--no-processing", action="store_true",
                    help="spectra of the records as read (default: the default processing chain)")
     s.set_defaults(func=cmd_select)
+
+    s = sub.add_parser("export", help="a study's results as CSV tables (runs, fragility)",
+                       description="Write the per-run table (runs.csv: EDPs, scale factors, "
+                       "failure, exceedance per limit state) and the fitted fragility table "
+                       "(fragility.csv: definition, median, bootstrap band, beta) of a results "
+                       "file of 'shipblock run'; every column of a quantity names its unit, "
+                       "e.g. 'peak_ship_slip [m]'.")
+    s.add_argument("results", help="NetCDF written by 'run'")
+    s.add_argument("--csv", required=True, metavar="DIR", help="folder for the CSV tables")
+    s.set_defaults(func=cmd_export)
 
     s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "
                                      "batch scaling")

@@ -160,6 +160,25 @@ class SimulationResult:
         """Sample interval [s]."""
         return float(self.time[1] - self.time[0]) if self.time.size > 1 else 0.0
 
+    def __repr__(self) -> str:
+        """One line: duration, samples, failure and peaks (not the arrays, which ``to_dataset``
+        and the attributes give)."""
+        s = self.summary
+        n = self.time.size
+        duration = float(self.time[-1] - self.time[0]) if n else 0.0
+        failure = ("none" if self.failure is None
+                   else f"{self.failure} at t = {self.failure_time:.4g} s")
+        peaks = []
+        for key, label, factor, unit in (("peak_block_slip", "x_b", 100.0, "cm"),
+                                         ("peak_rotation", "theta", 1000.0, "mrad"),
+                                         ("peak_ship_slip", "x_s", 100.0, "cm")):
+            if key in s:
+                peaks.append(f"|{label}| {factor * float(s[key]):.4g} {unit}")
+        peak_text = f", peaks {', '.join(peaks)}" if peaks else ""
+        impacts = f", {int(s['n_impacts'])} impacts" if "n_impacts" in s else ""
+        return (f"SimulationResult({duration:.4g} s, {n} samples at dt = {self.dt:.4g} s, "
+                f"failure {failure}{peak_text}{impacts}, {len(self.events)} events)")
+
     def events_of(self, kind: str) -> list:
         """The events of one kind (for example ``"impact"``)."""
         return [e for e in self.events if e.kind == kind]

@@ -29,6 +29,7 @@ periods [s].
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -45,6 +46,7 @@ __all__ = [
     "ScaledRecord",
     "SpectrumMatch",
     "TargetSpectrum",
+    "acceleration_target",
     "amplitude_factor",
     "measure_value",
     "read_target_spectrum",
@@ -154,6 +156,49 @@ def _check_flag(value, name: str) -> bool:
     if not isinstance(value, bool | np.bool_):
         raise ParameterTypeError(f"{name} must be True or False, got {value!r}")
     return bool(value)
+
+
+_QUANTITY = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S*)\s*")
+
+
+def acceleration_target(text, name: str = "target") -> float:
+    """An acceleration target written with its unit (``"0.4g"``, ``"3.9 m/s^2"``, ``"392gal"``)
+    as m/s^2, for :func:`scale_record`'s ``target`` (e.g. ``--target-pga``).
+
+    The unit is required: a bare ``0.4`` would be 0.4 m/s^2 = 0.041 g where a PGA of 0.4 g was
+    almost surely meant, a silent factor of ten.
+
+    Parameters
+    ----------
+    text : str
+        A number and an acceleration unit of :data:`shipblock.units.ACCELERATION_UNITS_TO_SI`.
+    name : str
+        How messages name the value (a keyword or a command-line flag).
+
+    Returns
+    -------
+    float
+        The target [m/s^2], above zero (the scaled record is checked against 100 g by
+        :func:`scale_record`).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name``: not a number with a unit, an unknown unit (the known ones listed), no
+        unit, or a value out of range.
+    """
+    match = _QUANTITY.fullmatch(str(text))
+    if match is None:
+        raise ParameterError(f"{name} {text!r}: expected a number and its unit, e.g. 0.4g")
+    value, unit = float(match.group(1)), match.group(2)
+    if not unit:
+        raise ParameterError(f"{name} {text}: give its unit, e.g. {text}g, {text}m/s^2 or "
+                             f"{text}gal (a bare number would be m/s^2)")
+    try:
+        target = float(acceleration_to_si(value, unit))
+    except ParameterError as exc:
+        raise ParameterError(f"{name} {text}: {exc}") from None
+    return _check_target(target, name)
 
 
 def measure_value(acc, dt, measure="pga", period=None, damping=intensity.DEFAULT_DAMPING) -> float:
@@ -447,6 +492,14 @@ def scale_motion(motion, **options):
         ``shipblock.scaling.scale_record(...)`` in every trace's ``stats.processing``.
     scaled : ScaledRecord
         The factors and achieved measures.
+
+    Examples
+    --------
+    The pair is unpacked; the motion is what :func:`shipblock.simulate` takes
+    (``simulate(system, scale_motion(gm, target=...)[0])``)::
+
+        scaled_motion, info = scale_motion(gm, target=0.4 * 9.80665)
+        result = simulate(system, scaled_motion)
     """
     # lazy, for start-up time: the records import obspy
     from shipblock.records.motion import COMPONENT_KEY, check_motion

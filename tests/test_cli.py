@@ -148,9 +148,9 @@ def test_response_figure_window_ends_at_the_failure_and_keeps_labels_inside():
     assert 0.0 <= label[0].get_position()[0] <= 1.0
 
 
-def test_response_figure_draws_slip_lines_only_when_few():
-    """Hundreds of slip starts and stops would hide the curves: beyond the limit they are left
-    to the mode bands and counted in the legend; below it each is a line."""
+def test_response_figure_summarises_slip_events_and_draws_lines_only_when_asked():
+    """Slip starts and stops (hundreds in a stick-slip record) are left to the mode bands and
+    counted per interface in the legend; lines are drawn only when asked for."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -174,7 +174,10 @@ def test_response_figure_draws_slip_lines_only_when_few():
     many = plot_response(res)
     assert vertical_lines(many) == 0
     labels = [txt.get_text() for txt in many[3].get_legend().get_texts()]
-    assert f"{n_slip} slip starts and stops: see the mode bands" in labels
+    starts = sum(e.kind == "ground_slip_start" for e in res.events)
+    assert starts > 0 and not any(e.kind == "ship_slip_start" for e in res.events)
+    assert f"blocks on the floor: {starts} slip starts (see the mode bands)" in labels
+    assert not any("ship on the blocks" in label for label in labels)
     few = plot_response(res, max_slip_event_lines=n_slip)
     assert vertical_lines(few) == 3 * n_slip  # one line per event in each of three panels
 

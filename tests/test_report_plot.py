@@ -10,7 +10,14 @@ import pytest
 from shipblock.cli import main
 from shipblock.fragility.pipeline import run_pipeline
 from shipblock.fragility.report import fit_lines, study_report
-from shipblock.plot import DODGE, plot_fragility, plot_median_sweep, sweep_selection
+from shipblock.plot import (
+    marker_sizes,
+    plot_fragility,
+    plot_ida,
+    plot_median_sweep,
+    study_caption,
+    sweep_selection,
+)
 from shipblock.units import STANDARD_GRAVITY as G
 
 from .test_pipeline import write_pipeline
@@ -62,7 +69,7 @@ def test_sweep_selection_matches_values_and_names_the_choices(sweep_run):
 def test_fragility_figure_names_thresholds_records_per_level_and_the_swept_value(sweep_run):
     _, _, ds = sweep_run
     ax = plot_fragility(ds, sweep={"mu_ship": 0.35})
-    title = ax.get_title()
+    title = ax.get_title(loc="left")
     assert "3 records per level" in title and "mu_ship = 0.35" in title
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
     assert labels[0].startswith("ship_slip (peak_ship_slip > 0.005 m)")
@@ -70,15 +77,66 @@ def test_fragility_figure_names_thresholds_records_per_level_and_the_swept_value
     median = float(ds["median"].sel(limit_state="ship_slip", mu_ship=0.35)) / G
     if np.isfinite(median):
         assert f"median {median:.3g} g" in labels[0]
-    # observed fractions of the two limit states side by side at every level, the offset
-    # DODGE of the axis, and the fractions the counts of the study
+    # observed fractions at the levels themselves (not shifted), nested: the first limit
+    # state's hollow marker the larger, and the fractions the counts of the study
     markers = [ln for ln in ax.get_lines() if ln.get_linestyle() == "None"]
     assert len(markers) == 2
-    x0, x1 = (ln.get_xdata() for ln in markers)
-    np.testing.assert_allclose(x1 - x0, DODGE * ax.get_xlim()[1], rtol=1e-12)
-    np.testing.assert_allclose((x0 + x1) / 2, [0.2, 0.3, 0.4, 0.45, 0.5], rtol=1e-12)
+    for line in markers:
+        np.testing.assert_allclose(line.get_xdata(), [0.2, 0.3, 0.4, 0.45, 0.5], rtol=1e-12)
+        assert line.get_markerfacecolor() == "none"
+    assert [ln.get_markersize() for ln in markers] == marker_sizes(2)
+    assert markers[0].get_markersize() > markers[1].get_markersize()
+    assert "not shifted" in title and "nest" in title
     ex = ds["exceeded"].sel(limit_state="ship_slip", mu_ship=0.35)
     np.testing.assert_array_equal(markers[0].get_ydata(), ex.mean("record").values)
+
+
+def test_study_figures_say_which_study_system_and_design_they_show(sweep_run):
+    tmp, path, ds = sweep_run
+    caption = study_caption(ds, {"mu_ship": 0.35})
+    # the pipeline's title and file, the system with the swept value drawn, the design
+    assert caption[0] == f"test ({path.name})" or caption[0] == f"test ({path})"
+    assert caption[1] == ("system: ship 5000 t on 150 blocks of 1.2 t, 2B x 2H = 0.6 x 1.2 m; "
+                          "friction blocks-floor 0.6/0.55, ship-blocks 0.35/0.3 (static/kinetic)")
+    assert study_caption(ds, {"mu_ship": 0.3})[1].endswith(
+        "ship-blocks 0.3/0.257 (static/kinetic)")  # kinetic/static ratio 0.30/0.35 kept
+    assert caption[2] == ("design: IDA on PGA, 3 records x 5 levels (0.2 to 0.5 g); vertical "
+                          "scaled with the horizontal")
+    figures = (plot_fragility(ds, sweep={"mu_ship": 0.35}),
+               plot_ida(ds, sweep={"mu_ship": 0.35}),
+               plot_median_sweep(ds, "mu_ship"))
+    for ax in figures:
+        title = ax.get_title(loc="left")
+        assert caption[0] in title and "system: ship 5000 t on 150 blocks" in title
+        assert caption[2] in title
+    assert "IDA curves: " in figures[1].get_title(loc="left")
+    assert "mu_ship swept (x axis)" in figures[2].get_title(loc="left")
+
+
+def test_the_bootstrap_band_is_named_only_when_one_is_drawn(sweep_run):
+    from matplotlib.collections import PolyCollection
+
+    _, _, ds = sweep_run
+
+    def bands(ax):
+        return [c for c in ax.collections if isinstance(c, PolyCollection)]
+
+    # bootstrapped study: one band per limit state whose bounds exist at the value drawn
+    fitted = int(np.isfinite(ds["median_lower"].sel(mu_ship=0.35)).sum())
+    assert fitted >= 1
+    ax = plot_fragility(ds, sweep={"mu_ship": 0.35})
+    assert len(bands(ax)) == fitted
+    assert "shaded: 90 % bootstrap band of the median" in ax.get_title(loc="left")
+    # at mu_ship = 0.3 no curve was fitted, so no band: nothing drawn, nothing said
+    assert not np.isfinite(ds["median_lower"].sel(mu_ship=0.3)).any()
+    ax = plot_fragility(ds, sweep={"mu_ship": 0.3})
+    assert bands(ax) == [] and "bootstrap" not in ax.get_title(loc="left")
+    # a study without bootstrap: no band, and the title does not mention one
+    plain = ds.drop_vars(["median_lower", "median_upper"])
+    ax = plot_fragility(plain, sweep={"mu_ship": 0.35})
+    assert bands(ax) == [] and "shaded" not in ax.get_title(loc="left")
+    assert "bars" not in plot_median_sweep(plain).get_title(loc="left")
+    assert "bars: 90 % bootstrap band" in plot_median_sweep(ds).get_title(loc="left")
 
 
 def test_plot_command_draws_the_swept_value_asked_for_and_the_median_against_the_sweep(
@@ -98,3 +156,20 @@ def test_plot_command_draws_the_swept_value_asked_for_and_the_median_against_the
     line = ax.get_lines()[0]
     np.testing.assert_allclose(line.get_ydata(),
                                ds["median"].sel(limit_state="ship_slip").values / G)
+
+
+def test_cloud_figure_draws_each_records_outcome_at_its_intensity(tmp_path):
+    path = write_pipeline(tmp_path, kind="cloud", levels="")
+    ds = run_pipeline(path, progress=False)
+    ax = plot_fragility(ds)
+    title = ax.get_title(loc="left")
+    assert "design: cloud on PGA, 3 records at their own intensity" in title
+    assert "records' outcome (1: exceeded, 0: not)" in title
+    markers = [ln for ln in ax.get_lines() if ln.get_linestyle() == "None"]
+    assert len(markers) == 2
+    np.testing.assert_allclose(markers[0].get_xdata(), ds["achieved_im"].values / G,
+                               rtol=1e-12)
+    np.testing.assert_array_equal(markers[0].get_ydata(),
+                                  ds["exceeded"].sel(limit_state="ship_slip").values)
+    fitted = np.isfinite(ds["median"].values).any()
+    assert ("lines: lognormal fit" in title) == bool(fitted)

@@ -97,6 +97,22 @@ def _is_motion(value) -> bool:
     return all(hasattr(value, a) for a in ("horizontal", "vertical", "dt"))
 
 
+def _check_not_wrapped(ax) -> None:
+    """Refuse what :func:`shipblock.scaling.scale_motion` or ``scale_record`` returned, saying
+    what to pass instead (a tuple or a record object would otherwise fail as a missing ``dt``
+    or as an array of objects)."""
+    if isinstance(ax, tuple | list) and ax and _is_motion(ax[0]):
+        raise ParameterTypeError(
+            f"ax is a {type(ax).__name__} ({', '.join(type(v).__name__ for v in ax)}), not a "
+            "ground motion or an array: scale_motion returns (motion, scaled); pass its first "
+            "item, e.g. simulate(system, scale_motion(motion, ...)[0]) or motion, _ = "
+            "scale_motion(...); simulate(system, motion)")
+    if hasattr(ax, "horizontal") and hasattr(ax, "factor_h") and not hasattr(ax, "dt"):
+        raise ParameterTypeError(
+            f"ax is a {type(ax).__name__} (the result of scale_record), which holds no dt: pass "
+            "its arrays, simulate(system, scaled.horizontal, scaled.vertical, dt)")
+
+
 def simulate(
     system: ShipBlockSystem,
     ax,
@@ -171,6 +187,7 @@ def simulate(
     """
     if not isinstance(system, ShipBlockSystem):
         raise ParameterTypeError(f"system must be a ShipBlockSystem, got {type(system).__name__}")
+    _check_not_wrapped(ax)
     if _is_motion(ax):
         motion = ax
         for name, value in (("ay", ay), ("dt", dt)):
