@@ -1,17 +1,19 @@
 """Real agency files for the reader tests: where to find them, what gmprocess read from them.
 
-The files are the strong-motion test corpus of the USGS ``groundmotion-processing`` (gmprocess)
-repository, folder ``gmprocess/data/testdata/<format>/`` at commit :data:`CORPUS_COMMIT`. They are
-not committed here: the project takes no data out of other repositories into its own history. A
-test asks :func:`corpus_file` for a file by its path below ``testdata/`` and gets a local copy
-from the first of these that has it, or is skipped with the reason:
+Two collections of real files are used, both kept outside the project's history (the project
+takes no data out of other repositories into its own) in the team's shared folder beside the
+project root, ``../shared/records/``:
 
-1. the folder named by the environment variable ``SHIPBLOCK_REAL_CORPUS`` (laid out as
-   ``testdata/``: ``<folder>/dmg/ci15481673/CIWLT.V2``);
-2. ``shared/records/gmprocess-testdata/`` beside the project (the team's shared data);
-3. a git snapshot of the repository (``SHIPBLOCK_GMPROCESS_GIT``, or
-   ``.mirror/usgs+groundmotion-processing/repo`` beside the project), read with ``git show``
-   into a cache folder below the system's temporary directory.
+* ``gmprocess-testdata/``: the strong-motion test corpus of the USGS ``groundmotion-processing``
+  (gmprocess) repository, folder ``gmprocess/data/testdata/<format>/`` at commit
+  :data:`CORPUS_COMMIT` (:func:`corpus_file`);
+* ``outside-tests/``: files from other public projects, its README naming each source
+  (:func:`outside_file`).
+
+The environment variables ``SHIPBLOCK_REAL_CORPUS`` and ``SHIPBLOCK_OUTSIDE_TESTS`` name other
+folders laid out the same way. A file that is absent skips its test on a developer's machine but
+fails it in CI (environment variable ``CI`` set to ``true`` or ``1``): the real-file tests must
+run there, not skip.
 
 :data:`REFERENCE` is the table of peaks that gmprocess 2.8.0's own readers give for every file of
 the corpus (``tests/data/reference/gmprocess_2.8_peaks.csv``, made by
@@ -23,9 +25,6 @@ from __future__ import annotations
 
 import csv
 import os
-import shutil
-import subprocess
-import tempfile
 from collections import defaultdict
 from pathlib import Path
 
@@ -34,69 +33,58 @@ import pytest
 #: Commit of usgs/groundmotion-processing whose ``gmprocess/data/testdata`` the tests use.
 CORPUS_COMMIT = "11df19fe8ebe11dbbbff8e974a4521637185cb65"
 
-#: Folder of the corpus inside that repository.
-CORPUS_PREFIX = "gmprocess/data/testdata"
-
 PROJECT = Path(__file__).resolve().parents[1]
+SHARED_RECORDS = PROJECT.parent / "shared" / "records"
 REFERENCE_CSV = PROJECT / "tests" / "data" / "reference" / "gmprocess_2.8_peaks.csv"
 
 
-def _directories():
-    env = os.environ.get("SHIPBLOCK_REAL_CORPUS")
-    if env:
-        yield Path(env)
-    yield PROJECT.parent / "shared" / "records" / "gmprocess-testdata"
+def in_ci() -> bool:
+    """Whether the tests run in CI (``CI`` set to ``true``/``1``/``yes``, as CI services do)."""
+    return os.environ.get("CI", "").strip().lower() in ("true", "1", "yes")
 
 
-def _git_dirs():
-    env = os.environ.get("SHIPBLOCK_GMPROCESS_GIT")
-    if env:
-        yield Path(env)
-    yield PROJECT.parent / ".mirror" / "usgs+groundmotion-processing" / "repo"
-    yield Path("/work/.mirror/usgs+groundmotion-processing/repo")
+def _folder(variable: str, default: str) -> Path:
+    env = os.environ.get(variable)
+    return Path(env) if env else SHARED_RECORDS / default
 
 
-def _cache_dir() -> Path:
-    return Path(tempfile.gettempdir()) / f"shipblock-real-corpus-{CORPUS_COMMIT[:12]}"
+def corpus_dir() -> Path:
+    """Folder of the gmprocess corpus (``testdata/``)."""
+    return _folder("SHIPBLOCK_REAL_CORPUS", "gmprocess-testdata")
+
+
+def outside_dir() -> Path:
+    """Folder of the files from other projects."""
+    return _folder("SHIPBLOCK_OUTSIDE_TESTS", "outside-tests")
 
 
 def find_corpus_file(relpath: str) -> Path | None:
-    """Return a local copy of ``testdata/<relpath>``, or ``None`` if no source has it."""
-    for directory in _directories():
-        candidate = directory / relpath
-        if candidate.is_file():
-            return candidate
-    cached = _cache_dir() / relpath
-    if cached.is_file():
-        return cached
-    git = shutil.which("git")
-    if git is None:
-        return None
-    for git_dir in _git_dirs():
-        if not git_dir.is_dir():
-            continue
-        result = subprocess.run(
-            [git, f"--git-dir={git_dir}", "show", f"{CORPUS_COMMIT}:{CORPUS_PREFIX}/{relpath}"],
-            capture_output=True,
-            check=False,
-        )
-        if result.returncode == 0 and result.stdout:
-            cached.parent.mkdir(parents=True, exist_ok=True)
-            partial = cached.with_name(cached.name + f".{os.getpid()}.part")
-            partial.write_bytes(result.stdout)
-            partial.replace(cached)  # atomic: parallel test processes never see half a file
-            return cached
-    return None
+    """Return ``testdata/<relpath>`` of the gmprocess corpus, or ``None`` if it is absent."""
+    candidate = corpus_dir() / relpath
+    return candidate if candidate.is_file() else None
+
+
+def _missing(what: str, folder: Path, variable: str):
+    message = (f"real test file {what} not found in {folder} (the team's shared records beside"
+               f" the project root, or the folder named by {variable})")
+    if in_ci():
+        pytest.fail(message + "; CI must run the real-file tests, not skip them", pytrace=False)
+    pytest.skip(message)
 
 
 def corpus_file(relpath: str) -> Path:
-    """Return a local copy of ``testdata/<relpath>``; skip the test if the corpus is absent."""
+    """Return ``testdata/<relpath>``; skip the test if the corpus is absent (fail in CI)."""
     path = find_corpus_file(relpath)
     if path is None:
-        pytest.skip(
-            f"real corpus file {relpath} not found (set SHIPBLOCK_REAL_CORPUS, or put the"
-            " gmprocess testdata in shared/records/gmprocess-testdata)"
-        )
+        _missing(relpath, corpus_dir(), "SHIPBLOCK_REAL_CORPUS")
+    return path
+
+
+def outside_file(relpath: str) -> Path:
+    """Return ``outside-tests/<relpath>``; skip the test if it is absent (fail in CI)."""
+    path = outside_dir() / relpath
+    if not path.is_file():
+        _missing(relpath, outside_dir(), "SHIPBLOCK_OUTSIDE_TESTS")
     return path
 
 

@@ -2,7 +2,7 @@
 
 obspy tries the plug-ins' ``isFormat`` functions one after another and takes the first that says
 yes, so two detectors that both accept a file would make the format depend on entry-point order.
-Files: the gmprocess test corpus (tests/real_corpus.py; skipped where absent).
+Files: the gmprocess test corpus (tests/real_corpus.py; skipped where absent, a failure in CI).
 """
 
 from __future__ import annotations

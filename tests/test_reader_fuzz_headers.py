@@ -19,16 +19,18 @@ from __future__ import annotations
 
 import io
 import math
+import re
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from obspy import Trace, UTCDateTime
 
 from shipblock.errors import ShipblockError
+from shipblock.io._common import PolarityReversalWarning
 from shipblock.records.reading import read_motion
 from tests.reader_fuzz import (
     sac_field_mutations,
@@ -46,6 +48,8 @@ SENSITIVITY = 213473.004110264  # NP.1737 HNZ, counts/(M/S**2)
 UNIT_SI = {"gal": 0.01, "g": G, "cm/s2": 0.01, "nm/s^2": 1e-9, "M/S**2": 1.0, "CM/S**2": 0.01,
            "NM/S**2": 1e-9, "G": G}
 PLAUSIBLE = dict(delta=(1e-4, 1.0), count=(1e-12, 1e3), peak=100 * G)
+#: Range of start times a record may have (the oldest strong-motion records are of 1933).
+EARLIEST, LATEST = UTCDateTime(1900, 1, 1), UTCDateTime(2200, 1, 1)
 
 
 def _sac_bytes() -> bytes:
@@ -76,7 +80,10 @@ def _expected_sac(field, value):
     elif field == "npts" and value != SAMPLES.size:
         return None  # the header no longer matches the data: no correct read
     elif field == "b":
-        if not (math.isfinite(f32) and abs(f32) < 1e9):
+        # The first sample is at the reference time + B; the readers accept starts in 1900-2200
+        # (a rule on the resulting time, not on B: B = 1e9 s is a start in 2051).
+        seconds = START.timestamp + f32 if math.isfinite(f32) else math.nan
+        if not EARLIEST.timestamp <= seconds < LATEST.timestamp:
             return None
         start = START + f32
     elif field == "scale":
@@ -127,6 +134,9 @@ def test_sac_header_field(tmp_path, field, value):
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(field=st.sampled_from(["delta", "scale", "b"]),
        value=st.floats(allow_nan=True, allow_infinity=True, width=32))
+@example(field="b", value=1e9)  # a start in 2051: read (the old rule |B| < 1e9 refused it)
+@example(field="b", value=5.7e9)  # a start after 2200: refused
+@example(field="b", value=-3.8e9)  # a start before 1900: refused
 def test_sac_header_float_drawn(tmp_path, field, value):
     _check_sac(tmp_path, field, value)
 
@@ -154,6 +164,8 @@ def _expected_vertical(element, value, reference):
         unit = value
         if unit not in UNIT_SI:
             return None  # not an acceleration (a velocity needs differentiate=True)
+    if sensitivity < 0:
+        return None  # NP.1737's stage gains are positive: a negative overall value is damaged
     count = UNIT_SI[unit] / sensitivity if sensitivity else math.inf
     if not (math.isfinite(count) and PLAUSIBLE["count"][0] <= abs(count) <= PLAUSIBLE["count"][1]):
         return None
@@ -186,14 +198,45 @@ def test_stationxml_field(tmp_path, napa_reference, element, value):
     _check_xml(tmp_path, element, value, napa_reference)
 
 
-def test_negative_sensitivity_is_polarity_not_damage(tmp_path, napa_reference):
-    """The sign flip case above, said plainly: a negative sensitivity reverses the sign."""
+def _first_channel_xml(text: str, flip_stage: bool = False, drop_stages: bool = False) -> str:
+    """NP.1737.xml with its first channel's overall sensitivity negated, and optionally its first
+    stage gain negated too (a documented reversed channel) or its stages removed."""
+    text = stationxml_patch(text, "Value", f"{-SENSITIVITY!r}")
+    head, sep, rest = text.partition("</Channel>")  # the first channel only
+    if flip_stage:
+        head = re.sub(r"(<StageGain>\s*<Value>)([^<]*)", lambda m: m.group(1) + f"-{m.group(2)}",
+                      head, count=1)
+    if drop_stages:
+        head = re.sub(r"<Stage number=.*?</Stage>\s*", "", head, flags=re.DOTALL)
+    return head + sep + rest
+
+
+def test_negative_sensitivity_against_stage_gains(tmp_path, napa_reference):
+    """A negative overall sensitivity is a reversed channel only if the stage gains say so too:
+    with positive stage gains it is a damaged sign, refused."""
     path = tmp_path / "NP.1737.xml"
-    path.write_text(stationxml_patch((NAPA / "NP.1737.xml").read_text(), "Value",
-                                     f"{-SENSITIVITY!r}"))
+    original = (NAPA / "NP.1737.xml").read_text()
+    path.write_text(_first_channel_xml(original))
+    got = _read(NAPA / "NP.1737.mseed", inventory=path)
+    assert isinstance(got, ShipblockError) and "stage gains" in str(got), got
+    path.write_text(_first_channel_xml(original, flip_stage=True))  # as BK.VALB documents it
     gm = read_motion(NAPA / "NP.1737.mseed", inventory=path)
     np.testing.assert_allclose(gm.components["V"], -napa_reference["V"], rtol=1e-12)
     assert "polarity is reversed" in gm.metadata["units"]["V"]
+
+
+def test_negative_sensitivity_without_stages_is_said_and_refusable(tmp_path, napa_reference):
+    """No stage gains to confirm a negative sensitivity: read as reversed with a loud
+    PolarityReversalWarning, which a user turns into an error to refuse the record."""
+    path = tmp_path / "NP.1737.xml"
+    path.write_text(_first_channel_xml((NAPA / "NP.1737.xml").read_text(), drop_stages=True))
+    with pytest.warns(PolarityReversalWarning, match="no stage gain confirms it"):
+        gm = read_motion(NAPA / "NP.1737.mseed", inventory=path)
+    np.testing.assert_allclose(gm.components["V"], -napa_reference["V"], rtol=1e-12)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PolarityReversalWarning)
+        with pytest.raises(ShipblockError, match="NP.1737.xml.*negative"):
+            read_motion(NAPA / "NP.1737.mseed", inventory=path)
 
 
 @settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])

@@ -22,7 +22,8 @@ SHIPBLOCK_SMC       :mod:`shipblock.io.smc`            USGS SMC
 SHIPBLOCK_TEXT      :mod:`shipblock.io.text`           one/two-column text or CSV (stated units)
 ==================  =================================  ==========================================
 
-K-NET and KiK-net files are read by obspy and renamed the SEED way by
+K-NET and KiK-net files are read by obspy, renamed the SEED way, freed of the digitiser's offset
+(NIED's mean of the record) and checked against their header's duration and ``Max. Acc.`` by
 :func:`shipblock.io.knet.normalise_knet`.
 
 :func:`read_record` wraps :func:`obspy.read` so that every failure becomes a
@@ -36,21 +37,27 @@ opened (:mod:`shipblock.checks`, :func:`check_format`): a wrong one is a
 
 from __future__ import annotations
 
+import os
 import warnings
 
 import numpy as np
 import obspy
+from obspy.core import AttribDict
 
 from shipblock import checks
 from shipblock.errors import ParameterError, ParameterTypeError, RecordError, ShipblockError
 from shipblock.io import at2, bhrc, cosmos, cwb, dmg, esm, geonet, nsmn, renadic, smc, text, unam, usc
+from shipblock.io import mseed as mseed_checks
+from shipblock.io import screen
 from shipblock.io._common import (
     MAX_DIGITIZATION_GAP_S,
+    PolarityReversalWarning,
     check_count_value,
     check_plausible_samples,
     check_sampling_interval,
     check_start_time,
     peek_text,
+    sensitivity_sign,
 )
 from shipblock.io.knet import normalise_knet
 
@@ -59,12 +66,14 @@ from shipblock.io.knet import normalise_knet
 __all__ = [
     "FORMATS",
     "MAX_DIGITIZATION_GAP_S",
+    "PolarityReversalWarning",
     "check_count_value",
     "check_format",
     "check_plausible_samples",
     "check_sampling_interval",
     "known_formats",
     "read_record",
+    "sensitivity_sign",
 ]
 
 #: Words of a reader's warning that mean the file is damaged: libmseed's reports (truncated
@@ -167,17 +176,24 @@ def _is_damage(warning) -> bool:
     return any(word in message for word in DAMAGE_WORDS)
 
 
-def _check_mseed_size(stream, name: str) -> None:
-    """Refuse a MiniSEED file whose bytes are not all in the records obspy read.
+def _check_mseed(stream, name: str) -> None:
+    """Refuse a MiniSEED file whose bytes are not all in the records obspy read, or whose
+    encoding byte hides Steim frames; attach a full SEED volume's own responses.
 
     libmseed skips a record cut short at the end of the file without a word when too little of
-    it is left to parse; the records read then cover fewer bytes than the file holds.
+    it is left to parse; the records read then cover fewer bytes than the file holds. The control
+    headers of a full SEED volume (its dataless part) are counted as read
+    (:mod:`shipblock.io.mseed`).
     """
     mseed = [tr.stats.mseed for tr in stream if tr.stats.get("_format") == "MSEED"
              and "mseed" in tr.stats]
     if not mseed or "filesize" not in mseed[0]:
         return
-    used = sum(int(m.number_of_records) * int(m.record_length) for m in mseed)
+    with open(name, "rb") as fh:
+        raw = fh.read()  # every record's encoding byte: obspy reports only the first record's
+    control = mseed_checks.control_header_bytes(raw)
+    mseed_checks.check_encodings(raw, name)
+    used = control + sum(int(m.number_of_records) * int(m.record_length) for m in mseed)
     size = int(mseed[0].filesize)
     if used != size:
         what = ("left over: a record cut short (truncated file?)" if size > used
@@ -186,6 +202,13 @@ def _check_mseed_size(stream, name: str) -> None:
             name, f"is damaged: its records hold {used} bytes but the file has {size}"
             f" ({abs(size - used)} bytes {what})"
         )
+    if control:
+        notes: list[str] = []
+        mseed_checks.attach_volume_responses(stream, name, notes)
+        for trace in stream:
+            trace.stats.seed_volume = AttribDict(control_header_bytes=control, notes=notes)
+        for note in notes:
+            warnings.warn(f"{name}: full SEED volume: {note}", stacklevel=3)
 
 
 def _check_trace(trace, name: str) -> None:
@@ -236,12 +259,18 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
         type): a path that is not a ``str`` or :class:`os.PathLike`, a format obspy does not
         know, an unknown unit, a ``dt``, ``resample_rate`` or ``resample_interval`` out of range.
     RecordError
-        If the file does not exist or is a folder, its format is unknown, or it is corrupt or
-        truncated: any libmseed diagnostic (a Steim integrity check, a record cut short) or
-        MiniSEED records that do not account for every byte of the file; NaN/inf samples; a
+        If the file does not exist or is a folder, its format is unknown (a file over 16 MB whose
+        start shows no record format is refused before obspy's sniffing, unless ``format`` is
+        given: :mod:`shipblock.io.screen`), or it is corrupt or
+        truncated: any libmseed diagnostic (a Steim integrity check, a record cut short),
+        MiniSEED records that do not account for every byte of the file (a full SEED volume's
+        control headers count), a record whose plain encoding hides Steim frames; NaN/inf samples; a
         sampling interval outside 1e-4..1 s; a start time outside 1900-2200; samples in m/s^2
         above 100 g.
     """
+    if isinstance(path, (str, os.PathLike)) and os.path.islink(path) and not os.path.exists(path):
+        raise RecordError(os.fspath(path), f"is a broken symbolic link (to"
+                                           f" {os.readlink(path)!r}, which does not exist)")
     name = checks.existing_file(path, "path", "a record file",
                                 "; read_motions() reads a folder of records")
     format = check_format(format)  # noqa: A001 - obspy's name for it
@@ -252,6 +281,8 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
             kwargs[key] = check(kwargs[key], key)
     if format == text.FORMAT:
         kwargs["units"] = units
+    if format is None:
+        screen.screen_large_file(name)  # before obspy's sniffing, which reads a large file whole
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
@@ -281,10 +312,10 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
     empty = [tr.id for tr in stream if tr.stats.npts == 0 or len(tr.data) == 0]
     if empty:
         raise RecordError(name, f"channel {empty[0]} has no samples (corrupt or truncated file?)")
-    _check_mseed_size(stream, name)
+    _check_mseed(stream, name)
     for trace in stream:
         _check_trace(trace, name)
-    normalise_knet(stream)
+    normalise_knet(stream, name)
     for trace in stream:
         trace.stats.source_file = name
     return stream

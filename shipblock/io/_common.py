@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import warnings
 
 import numpy as np
 from obspy import Trace, UTCDateTime
@@ -597,3 +598,68 @@ def orientation_stats(sampling_rate: float, *, vertical: bool, azimuth_deg: floa
                 letter = cardinal
     stats["channel"] = f"{band}N{letter}"
     return stats
+
+
+class PolarityReversalWarning(RecordError, UserWarning):
+    """A channel read as wired with reversed polarity on the word of its sensitivity alone.
+
+    It is a warning (the record is read, its sign restored) and a :class:`RecordError`: turned
+    into an error by a warnings filter (``warnings.simplefilter("error",
+    PolarityReversalWarning)``; ``python -W error::shipblock.io._common.PolarityReversalWarning``),
+    it refuses the record by name in :func:`shipblock.read_motion`.
+    """
+
+
+def sensitivity_sign(response, name: str, what: str) -> str:
+    """Check the sign of a response's overall sensitivity against its stages; return a note.
+
+    A negative overall sensitivity states a channel wired with reversed polarity: dividing by it
+    restores the ground's sign (BK.VALB's HN1-HN3 in real BK metadata, whose first stage gain is
+    -1.02038). The overall sensitivity is the product of the stage gains (at the normalisation
+    frequency), so its sign must be theirs:
+
+    * stages whose gains multiply to a negative number confirm the reversal (a note says so);
+    * stages whose gains multiply to a positive number contradict it: a damaged sign, refused;
+    * no stage gains: nothing confirms it. It is read as a reversal and said loudly with a
+      :class:`PolarityReversalWarning`, which a user can turn into an error to refuse it.
+
+    Parameters
+    ----------
+    response : obspy.core.inventory.Response
+        The channel's response, with a finite non-zero overall sensitivity.
+    name : str
+        Source of the response (file), for messages.
+    what : str
+        The channel, for messages.
+
+    Returns
+    -------
+    str
+        ``""`` for a positive sensitivity, else a note for the conversion's description.
+
+    Raises
+    ------
+    RecordError
+        If the sensitivity is negative and the stage gains positive.
+    """
+    value = response.instrument_sensitivity.value
+    if value >= 0:
+        return ""
+    gains = [stage.stage_gain for stage in (response.response_stages or [])
+             if stage.stage_gain is not None and math.isfinite(stage.stage_gain)
+             and stage.stage_gain != 0]
+    if gains:
+        negative = sum(1 for gain in gains if gain < 0) % 2 == 1
+        if not negative:
+            raise RecordError(
+                name, f"{what}: overall sensitivity {value:.6g} is negative but its"
+                f" {len(gains)} stage gains multiply to a positive number: a damaged sign, not a"
+                " channel of reversed polarity")
+        return (" (negative, as the product of its stage gains: the channel's polarity is reversed"
+                " and is restored)")
+    warnings.warn(PolarityReversalWarning(
+        name, f"{what}: overall sensitivity {value:.6g} is negative and no stage gain confirms it;"
+        " read as a channel of reversed polarity and its sign restored. If the sign is a damaged"
+        " number, refuse such channels by turning PolarityReversalWarning into an error (python"
+        " -W error::shipblock.io._common.PolarityReversalWarning)"), stacklevel=4)
+    return " (negative, no stage gains to confirm it: polarity taken as reversed and restored)"

@@ -9,17 +9,23 @@ header lines, then the samples read horizontally line by line (usually 5 per lin
 3. quantity and units, e.g. ``ACCELERATION TIME SERIES IN UNITS OF G``;
 4. ``NPTS=  4000, DT=   .0100 SEC`` (NGA) or ``4000   0.0100   NPTS, DT`` (older PEER files).
 
-The samples are in g (the format's unit; the header says so) unless line 3 names another unit
-after ``UNITS OF``: ``MG`` (milli-g), ``G/100`` and ``%G`` (hundredths of g), ``CM/S2``/``GAL``,
-``MM/S2``, ``M/S2``, ``KM/S2``, ``IN/S2``, ``FT/S^2`` (any spelling of s^2: ``S2``, ``S**2``,
-``SEC/SEC``). They are converted to m/s^2 (g = :data:`shipblock.units.STANDARD_GRAVITY`);
-``stats.units`` is ``"m/s**2"`` and ``stats.original_units`` the unit. A word that is not an
-acceleration unit is refused: a velocity (``CM/S``) or length (``CM``: displacement) as such, any
-other word as unknown; velocity and displacement files (PEER ``.VT2``, ``.DT2``) are refused. DT
-must lie within 1e-4..1 s and the samples under 100 g. The component token of line 2 gives the orientation: a number
-is the azimuth [deg clockwise from north]; ``UP``/``V``/``VER``/``Z`` is vertical positive up and
-``DWN``/``DOWN`` vertical positive down. The file holds no start time, so traces start at the
-epoch (1970-01-01T00:00:00Z).
+The samples are in g (the format's unit; the header says so) unless line 3 names another unit after
+``UNITS OF`` or alone in parentheses (``(CM/S2)``): ``MG``/``MILLI-G`` (milli-g), ``G/100`` and
+``%G`` (hundredths of g), ``CM/S2``/``GAL``, ``MM/S2``, ``M/S2``, ``KM/S2``, ``IN/S2``, ``FT/S^2``
+(any spelling of s^2: ``S2``, ``S**2``, ``SEC/SEC``). They are converted to m/s^2 (g =
+:data:`shipblock.units.STANDARD_GRAVITY`); ``stats.units`` is ``"m/s**2"`` and
+``stats.original_units`` the unit. A word that is not an acceleration unit is refused: a velocity
+(``CM/S``) or length (``CM``: displacement) as such, any other word as unknown (also in
+parentheses: ``(FOO)`` is refused, not read as g; a processing word such as ``(ROTATED)`` is no
+unit statement); velocity and displacement files (PEER ``.VT2``, ``.DT2``) are refused. DT must lie
+within 1e-4..1 s (``DT= 1,5``, a decimal comma, is refused, not read as 1 s) and the samples under
+100 g. Values written in a fixed format (``E15.7``: 99 % of them alike) must all be: a last
+value cut short (``-.1234567E-0``, 100 times too large) is refused. The component token of line 2
+gives the orientation: a number is the azimuth [deg clockwise from north];
+``UP``/``V``/``VER``/``Z`` is vertical positive up and ``DWN``/``DOWN`` vertical positive down. The
+component word is the channel code (``stats.seed_channel`` is ``False``: it names no SEED sensor,
+so a ``DWN`` vertical stays with the ``164``/``254`` horizontals of its station). The file holds no
+start time, so traces start at the epoch (1970-01-01T00:00:00Z).
 
 References
 ----------
@@ -30,6 +36,7 @@ References
 from __future__ import annotations
 
 import re
+from collections import Counter
 
 from obspy import Stream
 from obspy.core import AttribDict
@@ -66,13 +73,21 @@ _TITLES = ("PEER", "PACIFIC ENGINEERING", "PAIFIC ENGINEERING", "NGA")
 _MAX_HEADER_LINES = 8
 
 _NPTS_DT_NGA = re.compile(
-    r"NPTS\s*=\s*(\d+)\s*[,;]?\s*DT\s*=\s*(" + FLOAT_RE.pattern + r")", re.IGNORECASE
+    r"NPTS\s*=\s*(\d+)\s*[,;]?\s*DT\s*=\s*([-+]?[\d.]*(?:,\d+)?(?:[EeDd][-+]?\d+)?)",
+    re.IGNORECASE,
 )
 _NPTS_DT_OLD = re.compile(
     r"^\s*(\d+)\s+(" + FLOAT_RE.pattern + r")\s+NPTS\s*,\s*DT", re.IGNORECASE
 )
 _UNITS_RE = re.compile(r"UNITS\s+OF\s+([A-Z/*^0-9'%]+)", re.IGNORECASE)
-_PAREN_RE = re.compile(r"\(([A-Z/*^0-9'% ]+)\)", re.IGNORECASE)
+#: Share of the values that must be written alike for a file to count as fixed-format.
+FIXED_FORMAT_SHARE = 0.99
+
+_SHAPE_RE = re.compile(r"[-+]?\d*(?:\.(\d*))?(?:[EeDd][-+]?(\d*))?")
+_PAREN_RE = re.compile(r"\(([^()]*)\)")
+#: A word in parentheses that describes the processing (``(ROTATED)``, ``(FILTERED)``): a past
+#: participle, not a unit.
+_PARTICIPLE_RE = re.compile(r"^[A-Z]+ED$", re.IGNORECASE)
 
 #: One foot [m] (international foot, 1959).
 FOOT = 0.3048
@@ -87,6 +102,9 @@ _EXTRA_ACCELERATION = {
     "km/s^2": 1000.0,
     "%g": 0.01 * STANDARD_GRAVITY,
     "g%": 0.01 * STANDARD_GRAVITY,
+    "milli-g": 1e-3 * STANDARD_GRAVITY,
+    "millig": 1e-3 * STANDARD_GRAVITY,
+    "micro-g": 1e-6 * STANDARD_GRAVITY,
 }
 
 #: Velocity and displacement units (normalised): an AT2 header naming one does not hold an
@@ -97,12 +115,43 @@ _VERTICAL_UP = {"UP", "V", "VER", "VERT", "Z", "HNZ", "HLZ", "HHZ", "HGZ"}
 _VERTICAL_DOWN = {"DWN", "DOWN", "DN"}
 
 
-def _npts_dt(line: str):
-    """Return ``(npts, dt)`` from a header line, or ``None``."""
-    match = _NPTS_DT_NGA.search(line) or _NPTS_DT_OLD.search(line)
+def _shape(token: str) -> tuple[int, int | None]:
+    """``(digits after the point, exponent digits or None)`` of a number as written."""
+    match = _SHAPE_RE.fullmatch(token)
     if match is None:
+        return -1, None
+    decimals, exponent = match.group(1), match.group(2)
+    return len(decimals or ""), (None if exponent is None else len(exponent))
+
+
+def _check_written_alike(tokens, name: str) -> None:
+    """Refuse a value written shorter than the file's fixed format (a value cut short).
+
+    When at least :data:`FIXED_FORMAT_SHARE` of the values are written with the same digits
+    (``E15.7``: seven decimals, a two-digit exponent), the file is in that fixed format and every
+    value must be; a value with other digits was cut (``-.1234567E-0`` reads 10 or 100 times too
+    large) or damaged. Files in free format (digits varying) are not checked.
+    """
+    if len(tokens) < 10:
+        return
+    shapes = [_shape(token) for token, _ in tokens]
+    shape, count = Counter(shapes).most_common(1)[0]
+    if count == len(shapes) or count < FIXED_FORMAT_SHARE * len(shapes):
+        return
+    index = next(k for k, other in enumerate(shapes) if other != shape)
+    token, lineno = tokens[index]
+    exponent = "" if shape[1] is None else f", a {shape[1]}-digit exponent"
+    raise RecordError(
+        name, f"line {lineno}: value {token!r} is not written like the other {count} ({shape[0]}"
+        f" decimals{exponent}): a value cut short (truncated file?) or a damaged digit")
+
+
+def _npts_dt(line: str):
+    """Return ``(npts, dt as written)`` from a header line, or ``None``."""
+    match = _NPTS_DT_NGA.search(line) or _NPTS_DT_OLD.search(line)
+    if match is None or not any(c.isdigit() for c in match.group(2)):
         return None
-    return int(match.group(1)), parse_float(match.group(2))
+    return int(match.group(1)), match.group(2)
 
 
 def _find_header(lines):
@@ -194,8 +243,11 @@ def _units(line: str, name: str) -> tuple[str, float, bool]:
     if stated is not None:
         word = stated.group(1).rstrip("'")
     else:
+        # A one-word group in parentheses is the unit slot (``(CM/S2)``), unless it is a
+        # processing word (``(ROTATED)``); phrases (``(HP=0.1 HZ, LP=25 HZ)``) are notes.
         words = [m.group(1).strip() for m in _PAREN_RE.finditer(line)]
-        word = next((w for w in words if _unit_factor(w) is not None), None)
+        words = [w for w in words if w and len(w.split()) == 1 and not _PARTICIPLE_RE.match(w)]
+        word = next((w for w in words if _unit_factor(w) is not None), words[0] if words else None)
         if word is None:
             # The AT2 format is defined in g; a header that does not repeat it still means g.
             return "g", STANDARD_GRAVITY, False
@@ -210,8 +262,8 @@ def _units(line: str, name: str) -> tuple[str, float, bool]:
         raise UnitsError(name, f"header line {line.strip()!r} gives the unit {word!r}, a length"
                                " (displacement): not an acceleration")
     raise UnitsError(
-        name, f"unknown acceleration unit {word!r} in header line {line.strip()!r}; known: g, mg,"
-        " g/N, %g, cm/s^2 (gal), mm/s^2, m/s^2, km/s^2, in/s^2, ft/s^2 (any spelling of s^2:"
+        name, f"unknown acceleration unit {word!r} in header line {line.strip()!r}; known: g, mg"
+        " (milli-g), g/N, %g, cm/s^2 (gal), mm/s^2, m/s^2, km/s^2, in/s^2, ft/s^2 (any spelling of s^2:"
         " s2, s**2, sec/sec)",
     )
 
@@ -251,7 +303,15 @@ def read_at2(filename, headonly: bool = False, **kwargs) -> Stream:
         found = None
     if found is None:
         raise RecordError(name, "is not a PEER AT2 file (no PEER title and NPTS/DT header line)")
-    npts_line, (npts, dt) = found
+    npts_line, (npts, dt_text) = found
+    if "," in dt_text:
+        raise RecordError(name, f"header line {npts_line + 1}: DT {dt_text!r} is written with a"
+                                " decimal comma; write it with a point (DT= 0.005)")
+    try:
+        dt = parse_float(dt_text)
+    except ValueError:
+        raise RecordError(name, f"header line {npts_line + 1}: DT {dt_text!r} is not a"
+                                " number") from None
     delta = check_sampling_interval(dt, name, "DT")
     header_lines = lines[: npts_line + 1]
     description = header_lines[1] if npts_line >= 2 else ""
@@ -276,6 +336,9 @@ def read_at2(filename, headonly: bool = False, **kwargs) -> Stream:
     stats = {
         "station": station,
         "channel": component,
+        # The component word of the file (``"164"``, ``"DWN"``), not a SEED code: ``DWN`` is no
+        # sensor ``DW`` apart from the horizontals of the same station.
+        "seed_channel": False,
         "units": "m/s**2",
         "original_units": unit,
         "shipblock_at2": header,
@@ -286,7 +349,7 @@ def read_at2(filename, headonly: bool = False, **kwargs) -> Stream:
         trace.stats.npts = npts
         return Stream([trace])
 
-    samples = []
+    samples, tokens = [], []
     for lineno, line in enumerate(lines[npts_line + 1 :], start=npts_line + 2):
         values = FLOAT_RE.findall(line)
         rest = FLOAT_RE.sub(" ", line).replace(",", " ").strip()
@@ -296,6 +359,8 @@ def read_at2(filename, headonly: bool = False, **kwargs) -> Stream:
             samples.extend(parse_float(v) for v in values)
         except ValueError:
             raise RecordError(name, f"line {lineno}: unreadable number") from None
+        tokens.extend((v, lineno) for v in values)
+    _check_written_alike(tokens, name)
     if len(samples) != npts:
         what = "truncated" if len(samples) < npts else "longer than its header says"
         raise RecordError(

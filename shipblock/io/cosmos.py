@@ -12,7 +12,8 @@ A file holds one or more channel blocks; each block has
 * ``N Comment line(s) follow, each starting with a "|":`` and the comments;
 * one data section per quantity, each introduced by a line such as
   ``8000 acceleration pts, approx 40 secs, units=cm/sec2 (04), Format=(8F10.5)``: V0/V1 files have
-  acceleration only, V2 files acceleration, velocity and displacement;
+  acceleration only, V2 files acceleration, velocity and displacement; its ``approx N secs`` is
+  checked against the samples x Real(62) (1 s + 1 %: a damaged interval is refused);
 * an end-of-data line.
 
 Header entries used (1-based, as numbered in the specification): Int(1) processing stage, Int(2)
@@ -82,6 +83,7 @@ import math
 import re
 import warnings
 
+import numpy as np
 from obspy import Stream, UTCDateTime
 from obspy.core import AttribDict
 
@@ -93,6 +95,7 @@ from shipblock.io._common import (
     check_samples,
     check_sampling_interval,
     fixed_fields,
+    horizontal_index,
     make_trace,
     orientation_stats,
     parse_float,
@@ -151,6 +154,11 @@ _DATA_HEADER = re.compile(
     r"^\s*(\d+)\s+(.*?)\s*pts\b(.*?)Format\s*=\s*\(\s*(\d+)\s*[EFGDI]\s*(\d+)(?:\.\d+)?\s*\)",
     re.IGNORECASE,
 )
+_APPROX_SECS = re.compile(r"approx\.?\s*(\d+(?:\.\d*)?)\s*sec", re.IGNORECASE)
+#: Tolerance of a data line's ``approx N secs`` against samples x interval: the printed
+#: rounding (whole seconds) and one per cent.
+APPROX_DURATION_ATOL_S = 1.0
+APPROX_DURATION_RTOL = 0.01
 _DATA_UNITS = re.compile(r"units\s*=\s*([^(,]*?)\s*\(\s*(\d+)\s*\)", re.IGNORECASE)
 #: ``Code:CE-J2236``; ``--`` (written ``---J2236``) is an unknown network.
 _STATION_CODE = re.compile(r"Code\s*:\s*([A-Za-z0-9]{1,2}|--)\s*-\s*([A-Za-z0-9]+)")
@@ -436,6 +444,7 @@ def _read_block(cursor: _Lines, name: str, headonly: bool, horizontals: list):
         code, unit_text = _data_units(data_line, _value(ints, 3, int_null), name, where)
         trace = _make_trace(name, text, ints, reals, comments, (int_null, real_null),
                             data_line, code, unit_text, npts, horizontals)
+        _check_approx_duration(data_line, npts, trace.stats.delta, name, block_line)
         if not headonly:
             samples = _fixed_width(block, npts, per_line, width, name, f"{kind} data",
                                    aligned=True)
@@ -463,7 +472,11 @@ def _channel(name, orientation, scnl, sampling_rate, horizontals, notes) -> tupl
             return f"{band_code(sampling_rate)}NX", {}
         index = orientation["index"]
         if not orientation["vertical"] and index is None:
-            index = min(len(horizontals) + 1, 2)  # non-cardinal or unknown azimuths in file order
+            # A stated azimuth names the axis (1 nearer north-south, 2 nearer east-west), so the
+            # horizontals of a station split into one file a channel never share a code; an
+            # unknown azimuth goes by file order.
+            index = (min(len(horizontals) + 1, 2) if orientation["azimuth"] is None
+                     else horizontal_index(orientation["azimuth"]))
         if not orientation["vertical"]:
             horizontals.append(index)
         stats = orientation_stats(
@@ -497,6 +510,23 @@ def _channel(name, orientation, scnl, sampling_rate, horizontals, notes) -> tupl
         return channel, {}
     stats.pop("channel")
     return channel, stats
+
+
+def _check_approx_duration(data_line: str, npts: int, delta: float, name: str, block_line: int):
+    """Refuse an interval Real(62) that contradicts the data line's ``approx N secs``.
+
+    The duration is printed in whole seconds (``42000 ... pts, approx  210 secs`` at 0.005 s);
+    :data:`APPROX_DURATION_ATOL_S` plus :data:`APPROX_DURATION_RTOL` of it is allowed.
+    """
+    match = _APPROX_SECS.search(data_line)
+    if match is None or npts == 0:
+        return
+    stated = float(match.group(1))
+    if abs(npts * delta - stated) > APPROX_DURATION_ATOL_S + APPROX_DURATION_RTOL * stated:
+        raise RecordError(
+            name, f"channel block at line {block_line}: {npts} samples of Real(62)"
+            f" {delta * 1000.0:g} ms span {npts * delta:g} s, but the data line says"
+            f" 'approx {match.group(1)} secs' (a damaged interval or count)")
 
 
 def _make_trace(name, text, ints, reals, comments, nulls, data_line, code, unit_text, npts,
@@ -618,7 +648,8 @@ def read_cosmos(filename, headonly: bool = False, **kwargs) -> Stream:
     Raises
     ------
     RecordError
-        If the file is not COSMOS, is truncated or corrupt, or holds NaN/inf samples.
+        If the file is not COSMOS, is truncated or corrupt, holds NaN/inf samples, or a channel
+        block repeats an earlier one (same SEED id or the same samples).
     UnitsError
         If a unit code is missing, inconsistent or not an acceleration.
     """
@@ -626,11 +657,32 @@ def read_cosmos(filename, headonly: bool = False, **kwargs) -> Stream:
     cursor = _Lines(read_text(filename).splitlines(), name)
     if cursor.at_end():
         raise RecordError(name, "is empty")
-    traces, horizontals = [], []
+    traces, horizontals, lines = [], [], []
     while not cursor.at_end():
+        line = cursor.index + 1
         trace = _read_block(cursor, name, headonly, horizontals)
         if trace is not None:
+            _check_not_repeated(trace, line, traces, lines, name)
             traces.append(trace)
+            lines.append(line)
     if not traces:
         raise RecordError(name, "holds no acceleration data section")
     return Stream(traces)
+
+
+def _check_not_repeated(trace, line: int, traces, lines, name: str) -> None:
+    """Refuse a channel block that repeats an earlier one (a duplicated block, not a channel).
+
+    A block repeats another if it has the same SEED id, or the same samples (not constant: two
+    dead channels may both be zero).
+    """
+    data = np.asarray(trace.data)
+    for other, other_line in zip(traces, lines, strict=True):
+        same_id = other.id == trace.id
+        same_samples = (data.size > 0 and other.data.shape == data.shape
+                        and np.ptp(data) > 0 and np.array_equal(other.data, data))
+        if same_id or same_samples:
+            what = f"channel {trace.id}" if same_id else f"the samples of {other.id}"
+            raise RecordError(
+                name, f"channel block at line {line} repeats {what} of the block at line"
+                f" {other_line} (a duplicated block: one channel cannot be two)")

@@ -32,8 +32,9 @@ What is read from where:
 * units: the data line (``in cm/sec2``, ``in units of g``, ``(UNITS: G)``) or, for time/value
   pairs, the header line ``UNITS OF UNCOR ACCEL ARE SEC AND G/10.``;
 * start time: ``Start time:`` or ``TRIGGER TIME:`` in the text header, in UTC (``PDT`` and ``PST``
-  times are converted). Two-digit years are completed with the year of integer-header value 24,
-  else so that the record is not later than its processing date;
+  times are converted); the fields may be blank-padded (``10:34: 1.0 UTC`` in CESMD's 2022 files).
+  Two-digit years are completed with the year of integer-header value 24, else so that the record
+  is not later than its processing date;
 * station: ``Station No. 89146`` / ``Station Id. WLT`` and the ``40.941N, 123.633W`` beside it; real
   header values 29-30 give the coordinates to more digits in newer files and are preferred. A
   ``<event>.<net>.<sta>.<loc>.<cha>`` record id (``15481673.CI.WLT.--.HN``) gives network and
@@ -41,6 +42,10 @@ What is read from where:
 * stated peak (``stats.stated_peak_si``): ``Peak acceleration = 77.280 cm/sec/sec at ...`` in
   volume 2, ``Max = .079 g , at ...`` in volume 1. The samples' peak must agree with it within a
   factor 2, which catches a misread unit (``g`` against ``g/10`` is a factor 10).
+
+* channel count: ``(3 Chns of  3 at Sta)`` in the text, else integer-header value 4. A file of
+  several channels but fewer than that (cut at a channel boundary) is refused; a file of one
+  channel is read (a channel file of its own).
 
 What the real files (USGS gmprocess test corpus) showed that a format description does not:
 
@@ -64,7 +69,10 @@ What the real files (USGS gmprocess test corpus) showed that a format descriptio
   ce36456p_CE36456.V2 is padded after its last channel with DOS end-of-file characters (Ctrl-Z),
   which are ignored.
 
-Channel codes follow :func:`shipblock.io._common.orientation_stats` (``HNE``, ``BNZ``, ...). If a
+Channel codes follow :func:`shipblock.io._common.orientation_stats` (``HNE``, ``BNZ``, ...); a
+horizontal of stated azimuth off north and east is ``HN1`` nearer north-south and ``HN2`` nearer
+east-west (:func:`~shipblock.io._common.horizontal_index`), whichever file it is in, so the two
+horizontals of a station split into one file a channel never share a code. If a
 file has several channels with the same code (structure arrays), every trace gets the channel
 number as its location code.
 
@@ -93,6 +101,7 @@ from shipblock.io._common import (
     check_samples,
     check_sampling_interval,
     fixed_fields,
+    horizontal_index,
     make_trace,
     orientation_stats,
     parse_float,
@@ -129,6 +138,8 @@ _NULL = -999
 
 # Positions (0-based) in the integer and real headers.
 _INT_ORIENTATION = 26
+_INT_CHANNEL_NUMBER = 2
+_INT_CHANNELS = 3
 _INT_YEAR = 23
 _REAL_LATITUDE = 28
 _REAL_LONGITUDE = 29
@@ -148,9 +159,10 @@ _NUMBER = FLOAT_RE.pattern
 _CHAN_RE = re.compile(r"^\s*CHAN\s+(\d+)\s*:\s*(.*?)\s*$", re.IGNORECASE)
 _START_RE = re.compile(
     r"(START|TRIGGER)\s+TIME\s*:\s*(\d{1,2})[/-](\d{1,2})[/-](\d{4}|\d{2})\s*,?\s*"
-    r"(\d{1,2}):(\d{1,2}):(\d{1,2}(?:\.\d*)?)\s*([A-Z]{1,3})?",
+    r"(\d{1,2})\s*:\s*(\d{1,2})\s*:\s*(\d{1,2}(?:\.\d*)?)\s*([A-Z]{1,3})?",
     re.IGNORECASE,
 )
+_CHANNELS_RE = re.compile(r"\(\s*(\d+)\s+CHNS\s+OF\s+(\d+)\s+AT\s+STA\s*\)", re.IGNORECASE)
 _PROCESSED_RE = re.compile(r"PROCESSED\s*:\s*(\d{1,2})/(\d{1,2})/(\d{4}|\d{2})\b", re.IGNORECASE)
 _STATION_RE = re.compile(r"STATION\s+(?:NO|ID)\.?\s+(\S+)", re.IGNORECASE)
 _LATLON_RE = re.compile(r"(\d+(?:\.\d*)?)\s*([NS])\s*,?\s*(\d+(?:\.\d*)?)\s*([EW])\b")
@@ -482,6 +494,39 @@ def _start_time(header_lines, ints, name, notes):
     return start + 3600.0 * _TIME_ZONES_H[zone], match.group(0).strip()
 
 
+def _channels_stated(header_lines, ints, number: int) -> tuple[int, str] | None:
+    """How many channels the record holds, as the header states it, and where.
+
+    The text's ``(3 Chns of  3 at Sta)`` (channels of this recorder, of the station), else
+    integer-header value 4 where value 3 is the channel's own number (the layout of every real
+    file: ``1  100    1    3    3``), else ``None``.
+    """
+    match = _search(_CHANNELS_RE, header_lines)
+    if match is not None and match.group(1).isdigit() and int(match.group(1)) > 0:
+        return int(match.group(1)), f"the text {match.group(0)!r}"
+    if (len(ints) > _INT_CHANNELS and ints[_INT_CHANNEL_NUMBER] == number
+            and ints[_INT_CHANNELS] is not None and 0 < ints[_INT_CHANNELS] < 100):
+        return ints[_INT_CHANNELS], f"integer-header value {_INT_CHANNELS + 1}"
+    return None
+
+
+def _check_all_channels(traces, name: str) -> None:
+    """Refuse a file cut at a channel boundary: more than one channel but fewer than stated.
+
+    A file of one channel is a channel file of its own (CESMD ships some so) and is read.
+    """
+    if len(traces) < 2:
+        return
+    dmg = traces[0].stats.shipblock_dmg
+    stated = dmg.get("channels_stated")
+    if stated is None or len(traces) >= stated[0]:
+        return
+    numbers = ", ".join(str(tr.stats.shipblock_dmg.channel_number) for tr in traces)
+    raise RecordError(
+        name, f"holds {len(traces)} channels ({numbers}) but {stated[1]} states {stated[0]}: the"
+        " file is cut at a channel boundary (truncated?)")
+
+
 def _coordinates(station_line: str, reals, notes):
     """Latitude and longitude [deg] of the station, or ``None``."""
     text = None
@@ -624,6 +669,7 @@ def _read_channel(volume, start, block, has_marker, name, headonly, resample_int
         notes.append(f"integer header orientation code {code} is not a known code; the text"
                      f" {orientation_text!r} is used")
     orientation = from_text or from_code
+    channels_stated = _channels_stated(header, ints, number)
     if orientation is not None and not orientation["vertical"] and orientation["azimuth"] is None:
         notes.append(f"horizontal {orientation_text!r} of unstated azimuth: azimuth left unset")
     if orientation is None:
@@ -749,6 +795,7 @@ def _read_channel(volume, start, block, has_marker, name, headonly, resample_int
         "shipblock_dmg": AttribDict({
             "volume": volume,
             "channel_number": number,
+            "channels_stated": channels_stated,
             "orientation_text": orientation_text,
             "orientation_code": code,
             "station_line": station_line.strip(),
@@ -835,7 +882,10 @@ def read_dmg(filename, headonly: bool = False, resample_interval=None, **kwargs)
             index = orientation.get("index")
             if not orientation["vertical"] and index is None:
                 horizontals += 1
-                index = horizontals
+                azimuth = orientation.get("azimuth")
+                # By the azimuth, not the file order: a set of one-channel files (CESMD's
+                # free-field sets at 110 and 20 deg) then names its horizontals 2 and 1.
+                index = horizontals if azimuth is None else horizontal_index(azimuth)
             stats.update(orientation_stats(
                 rate, vertical=orientation["vertical"], azimuth_deg=orientation.get("azimuth"),
                 positive_up=orientation.get("positive_up", True), index=index or 1))
@@ -845,6 +895,7 @@ def read_dmg(filename, headonly: bool = False, resample_interval=None, **kwargs)
         if headonly:
             trace.stats.npts = npts
         traces.append(trace)
+    _check_all_channels(traces, name)
     codes = [trace.stats.channel for trace in traces]
     if len(set(codes)) < len(codes):
         for trace in traces:

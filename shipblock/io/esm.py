@@ -22,6 +22,14 @@ test corpus) showed:
 * ``PGA_CM/S^2`` equals the largest sample in absolute value to the printed 6 decimals, with its
   sign, and ``TIME_PGA_S`` is that sample's index times ``SAMPLING_INTERVAL_S``.
 
+AFAD (Turkey) exports records in this layout with differences: the first sample's time written
+``2023/02/06 01:17:32.000000`` (read; a time in no known layout is refused, never put at 1970), and
+a place name under ``LOCATION`` (not a SEED location code of up to two letters or digits: the code
+is left empty and the name kept in the header, with a note).
+
+Cross-check: ``DURATION_S`` is ``NDATA`` x ``SAMPLING_INTERVAL_S`` in every real file; an interval
+or count that disagrees by more than one sample (a damaged number) is refused.
+
 Units: ``UNITS`` is honoured (converted to m/s^2; an unknown unit is refused). gmprocess ignores
 the key and always assumes cm/s^2. A file without ``UNITS`` is read only if its own
 ``PGA_CM/S^2`` (a value the key names in cm/s^2) equals the samples' peak read as cm/s^2: the file
@@ -77,12 +85,22 @@ PEAK_MATCH_RTOL = 0.01
 #: Absolute tolerance of that comparison [file units]: one unit of the 6th printed decimal.
 PEAK_MATCH_ATOL = 1e-6
 
+#: Resolution of ``DURATION_S`` as printed [s].
+DURATION_RESOLUTION_S = 0.001
+
 #: ``stats.units_source`` values.
 UNITS_FROM_HEADER = "UNITS header"
 UNITS_FROM_PGA = "no UNITS key; PGA_CM/S^2 agrees with the samples read as cm/s^2"
 
 _KEY_LINE = re.compile(r"^\s*([A-Z][A-Z0-9_/^.-]*)\s*:(.*)$")
-_TIME_FORMATS = ("%Y%m%d_%H%M%S.%f", "%Y%m%d_%H%M%S", "%Y-%m-%dT%H:%M:%S.%f", "%Y-%m-%dT%H:%M:%S")
+_TIME_FORMATS = ("%Y%m%d_%H%M%S.%f", "%Y%m%d_%H%M%S", "%Y-%m-%dT%H:%M:%S.%f", "%Y-%m-%dT%H:%M:%S",
+                 "%Y/%m/%d %H:%M:%S.%f", "%Y/%m/%d %H:%M:%S")
+
+#: Header key of the time of the first sample.
+START_KEY = "DATE_TIME_FIRST_SAMPLE_YYYYMMDD_HHMMSS"
+
+#: A SEED location code: up to two letters or digits (``--`` is the empty one).
+_SEED_LOCATION = re.compile(r"^(?:[A-Za-z0-9]{0,2}|--)$")
 
 
 def is_esm(filename) -> bool:
@@ -141,14 +159,42 @@ def _float(header, key, name, required=True):
     return value
 
 
-def _start_time(raw: str) -> UTCDateTime | None:
-    """Parse ``DATE_TIME_FIRST_SAMPLE_YYYYMMDD_HHMMSS``, or return ``None``."""
+def _start_time(raw: str, name: str) -> UTCDateTime | None:
+    """Parse ``DATE_TIME_FIRST_SAMPLE_YYYYMMDD_HHMMSS``; ``None`` if empty, refused if unreadable."""
+    text = raw.strip()
+    if not text:
+        return None
     for fmt in _TIME_FORMATS:
         try:
-            return UTCDateTime.strptime(raw.strip()[:26], fmt)
+            return UTCDateTime.strptime(text[:26], fmt)
         except Exception:  # noqa: BLE001 - try the next layout
             continue
-    return None
+    raise RecordError(name, f"header key {START_KEY}={raw.strip()!r} is not a time in a known"
+                            " layout (YYYYMMDD_hhmmss.fff, YYYY-MM-DDThh:mm:ss.f or"
+                            " YYYY/MM/DD hh:mm:ss.ffffff)")
+
+
+def _check_duration(header, delta: float, ndata: int, name: str) -> None:
+    """Refuse an interval that contradicts ``DURATION_S`` (ESM writes NDATA x interval)."""
+    duration = _float(header, "DURATION_S", name, required=False)
+    if duration is None or ndata == 0:
+        return
+    # The duration is printed to 1 ms; NDATA x interval or (NDATA - 1) x interval is meant.
+    if abs(duration - ndata * delta) > delta + DURATION_RESOLUTION_S:
+        raise RecordError(
+            name, f"header key SAMPLING_INTERVAL_S={header['SAMPLING_INTERVAL_S']} with"
+            f" NDATA={ndata} spans {ndata * delta:g} s, but DURATION_S={header['DURATION_S']}"
+            " (a damaged interval or count)")
+
+
+def _location(header, notes) -> str:
+    """The SEED location code of ``LOCATION``; a place name there (AFAD) is kept as a note."""
+    location = header.get("LOCATION", "")
+    if _SEED_LOCATION.match(location):
+        return "" if location == "--" else location
+    notes.append(f"LOCATION {location!r} is not a SEED location code (a place name?); the"
+                 " location code is left empty")
+    return ""
 
 
 def _peaks_agree(samples_peak: float, stated: float) -> bool:
@@ -218,6 +264,8 @@ def read_esm(filename, headonly: bool = False, **kwargs) -> Stream:
     if ndata != int(ndata) or ndata < 0:
         raise RecordError(name, f"NDATA={header['NDATA']!r} is not a sample count")
     ndata = int(ndata)
+    _check_duration(header, delta, ndata, name)
+    start = _start_time(header.get(START_KEY, ""), name)
     samples = None
     if not headonly or not header.get("UNITS", ""):
         samples = parse_free_floats(lines[first_data:], name, "acceleration samples")
@@ -228,15 +276,15 @@ def read_esm(filename, headonly: bool = False, **kwargs) -> Stream:
             )
         check_samples(samples, name, f"channel {header.get('STREAM') or '?'}")
     unit, factor, units_source = _units(header, samples, name)
-    location = header.get("LOCATION", "")
     esm = AttribDict(header)
     esm["notes"] = []
+    location = _location(header, esm["notes"])
     if units_source != UNITS_FROM_HEADER:
         esm["notes"].append(units_source)
     stats = {
         "network": header.get("NETWORK", ""),
         "station": header.get("STATION_CODE", ""),
-        "location": "" if location == "--" else location,
+        "location": location,
         "channel": header.get("STREAM", ""),
         "units": "m/s**2",
         "original_units": unit,
@@ -253,7 +301,6 @@ def read_esm(filename, headonly: bool = False, **kwargs) -> Stream:
         stats["coordinates"] = AttribDict(
             latitude=latitude, longitude=longitude, elevation=elevation or 0.0
         )
-    start = _start_time(header.get("DATE_TIME_FIRST_SAMPLE_YYYYMMDD_HHMMSS", ""))
     if headonly:
         trace = make_trace([], delta, stats)
         trace.stats.npts = ndata

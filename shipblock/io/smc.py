@@ -63,8 +63,9 @@ import numpy as np
 from obspy import Stream, UTCDateTime
 from obspy.core import AttribDict
 
-from shipblock.errors import RecordError, UnitsError
+from shipblock.errors import ParameterError, RecordError, UnitsError
 from shipblock.io._common import (
+    band_code,
     DEFAULT_RESAMPLE_RATE_HZ,
     FLOAT_RE,
     check_plausible_samples,
@@ -297,7 +298,9 @@ def _orientation(ints, null, component_text, rate, name) -> dict:
             rate, vertical=False, azimuth_deg=float(azimuth), index=horizontal_index(azimuth)
         )
     if vertical == null:
-        raise RecordError(name, "the header states no orientation (vertical or horizontal)")
+        # Nothing says vertical or horizontal (pyrotd's PEER copies): an unknown component that
+        # read_motion refuses unless the caller names it (channel_map).
+        return {"channel": f"{band_code(rate)}NX"}
     raise RecordError(
         name, f"vertical orientation {vertical} deg from up is neither vertical (0/180) nor"
         " horizontal (90)"
@@ -349,7 +352,7 @@ def _trim_pair_tail(values, per_line, npts, name) -> tuple[list[float], int]:
 
 
 def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RESAMPLE_RATE_HZ,
-             **kwargs) -> Stream:
+             data_type: str | None = None, **kwargs) -> Stream:
     """Read a USGS SMC acceleration file into a Stream of one trace in m/s^2.
 
     Parameters
@@ -361,6 +364,10 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
     resample_rate : float, optional
         Sampling rate [samples/s] onto which an unevenly digitized record (time, value pairs) is
         linearly interpolated. Evenly sampled records are returned as stored.
+    data_type : {"acceleration"}, optional
+        What a file whose line 1 is ``0 UNKNOWN`` holds, stated by the caller (pyrotd's test
+        files of PEER records are written so). Without it such a file is refused; a file that
+        states its own data type ignores it.
     **kwargs
         Ignored (obspy passes its own keywords to every plug-in).
 
@@ -396,8 +403,12 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
         raise UnitsError(name, f"holds {match.group(2).lower()}, not acceleration")
     if code in (5, 6):
         raise RecordError(name, f"holds {match.group(2).lower()}, not a time series")
-    if code == 0:
-        raise UnitsError(name, "data type is '0 UNKNOWN'; not known to be an acceleration")
+    if data_type not in (None, "acceleration"):
+        raise ParameterError(f"data_type must be None or 'acceleration', got {data_type!r}")
+    if code == 0 and data_type is None:
+        raise UnitsError(name, "data type is '0 UNKNOWN' (line 1): not known to be an"
+                               " acceleration; if it is one, say so with"
+                               " data_type='acceleration' (a read_record/read_motion keyword)")
     ints = _ints(lines[_TEXT_LINES : _TEXT_LINES + _INT_LINES], name)
     reals = _reals(lines[_TEXT_LINES + _INT_LINES : _HEADER_LINES], name)
     inull, rnull = ints[0], reals[0]
@@ -449,7 +460,8 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
     peak_text = _PEAK_TEXT.search(text[6])
     header = AttribDict(
         {
-            "data_type": match.group(2).upper(),
+            "data_type": (match.group(2).upper() if code != 0
+                          else "UNKNOWN (acceleration as the caller states)"),
             "station_code": text[2][:5].strip(),
             "event": text[3].strip(),
             "station_name": text[5].split("component")[0].replace("station =", "").strip(" ,"),
@@ -482,7 +494,7 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
     floor = ints[24]
     stats = {
         "network": "US" if "USGS" in header["data_source"].upper() else "",
-        "station": text[2][:4].strip(),
+        "station": text[2][:4].strip().strip("*"),  # "*": a line left blank
         "location": f"{floor:02d}" if ints[18] == 1 and floor != inull and 0 <= floor < 100
         else "",
         "units": "m/s**2",

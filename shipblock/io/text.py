@@ -1,17 +1,28 @@
 """Reader for plain one- or two-column text/CSV records (obspy plug-in ``SHIPBLOCK_TEXT``).
 
-A plain record is either one column (acceleration, the sampling interval given by the caller or a
-``dt = 0.01`` header line) or two columns (time [s], acceleration), separated by commas,
+A plain record is one column (acceleration, the sampling interval given by the caller or a
+``dt = 0.01`` header line), two columns (time [s], acceleration), or four: time and three
+components named in a header line (the SCEC broadband platform's ``.bbp``: ``# Time (s), NS
+(cm/s/s), EW (cm/s/s), UD (cm/s/s)``; NS/N-S/N, EW/E-W/E, UD/U-D/UP/Z/V), separated by commas,
 semicolons, tabs or spaces. Lines starting with ``#``, ``%``, ``!``, ``;`` or ``//`` are comments;
 non-numeric lines before the first sample (a CSV header such as ``time,accel``) are header lines.
+A blank line between the samples of a one-column record is refused (it may be a lost sample, and
+one column has no time to tell); two-column records are checked by their time column.
 
-Plain text carries no agreed unit, so the unit must be stated: either by the caller
-(``units="g"``, ``"m/s^2"``, ``"cm/s^2"``, ``"gal"``, ...) or in a header line, in brackets after
-the quantity (``# Time (s),Acceleration (g's)``, ``accel [m/s^2]``) or as ``units: cm/s^2``. A
-file with neither is refused with :class:`~shipblock.errors.UnitsError`; if both are given they
-must agree. For the same reason :func:`is_text` auto-detects only files whose header states an
-acceleration unit; any other plain file is read with ``format="SHIPBLOCK_TEXT"`` and ``units=``,
-or through :func:`shipblock.read_motion` with ``units=``.
+Plain text carries no agreed unit, so the unit must be stated: either by the caller (``units="g"``,
+``"m/s^2"``, ``"cm/s^2"``, ``"gal"``, ...) or in a header line, in brackets after the quantity (``#
+Time (s),Acceleration (g's)``, ``accel [m/s^2]``) or as ``units: cm/s^2``. A file with neither is
+refused with :class:`~shipblock.errors.UnitsError`; if both are given they must agree (in kind and
+size: ``g`` and ``gal`` contradict each other, ``cm/s^2`` and ``gal`` do not), and so must all of a
+header's statements (``accel (g)`` and ``units: cm/s^2`` are refused). A velocity unit (``cm/s``,
+``m/s``) gives a velocity trace (``stats.units == "m/s"``) that :func:`shipblock.read_motion`
+differentiates when asked to (``--differentiate``). A unit after a peak value's name (``PGV
+(cm/s)``) is not a statement about the samples. A header that calls the samples one quantity and
+gives the unit of another (``Acceleration ... in units of cm/s``) is refused unless the caller
+states the unit, which then decides. For the same reason :func:`is_text` auto-detects only files
+whose header states an acceleration unit; any other plain file is read with
+``format="SHIPBLOCK_TEXT"`` and ``units=``, or through :func:`shipblock.read_motion` with
+``units=``.
 """
 
 from __future__ import annotations
@@ -33,7 +44,13 @@ from shipblock.io._common import (
     read_text,
     source_name,
 )
-from shipblock.units import canonical_unit, si_factor
+from shipblock.units import (
+    ACCELERATION_UNITS_TO_SI,
+    VELOCITY_UNITS_TO_SI,
+    canonical_unit,
+    canonical_velocity_unit,
+    si_factor,
+)
 
 __all__ = ["FORMAT", "TIME_STEP_TOLERANCE", "is_text", "read_text_record"]
 
@@ -47,6 +64,8 @@ _COMMENT_PREFIXES = ("#", "%", "!", ";", "//")
 _SPLIT = re.compile(r"[,;\s]+")
 _BRACKETED = re.compile(r"[\(\[\{]\s*([^\)\]\}]+?)\s*[\)\]\}]")
 _UNITS_KEY = re.compile(r"\bunits?\s*[:=]\s*([^\s,;]+)", re.IGNORECASE)
+#: Names of a peak value: a unit after one is the value's, not the samples' (``PGV (cm/s)``).
+_PEAK_NAME = re.compile(r"^(?:PG[ADV]|PEAK|MAX(?:IMUM)?|MIN(?:IMUM)?)$", re.IGNORECASE)
 _DT_KEY = re.compile(r"\b(?:dt|delta)\s*[:=]\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)",
                      re.IGNORECASE)
 
@@ -73,10 +92,14 @@ def _split(lines, name: str, strict: bool):
     -------
     header : list of str
     rows : list of list of float
+    blanks : list of int
+        Line numbers of blank lines between two numeric rows.
     """
-    header, rows = [], []
+    header, rows, blanks, pending = [], [], [], []
     for lineno, line in enumerate(lines, start=1):
         if not line.strip():
+            if rows:
+                pending.append(lineno)
             continue
         if _is_comment(line):
             header.append(line)
@@ -90,11 +113,49 @@ def _split(lines, name: str, strict: bool):
             header.append(line)
             continue
         rows.append(values)
-    return header, rows
+        blanks += pending
+        pending = []
+    return header, rows, blanks
+
+
+def _unit_kind(word: str) -> tuple[str, str] | None:
+    """``(canonical unit, "acceleration" | "velocity")`` of a unit word, or ``None``."""
+    key = canonical_unit(word)
+    if key is not None:
+        return key, "acceleration"
+    key = canonical_velocity_unit(word)
+    return (key, "velocity") if key is not None else None
+
+
+def header_unit_statements(header_lines) -> list[tuple[str, str]]:
+    """Every distinct unit of the samples the header lines state, in order of appearance.
+
+    A statement is a word in brackets (``accel (g)``, ``[cm/s^2]``) or after ``units:``, that is
+    an acceleration or a velocity unit (time units, ``(s)``, and other words are not); one after a
+    peak value's name (``PGV (cm/s)``, ``peak (g)``) states the unit of that value, not of the
+    samples, and is left out.
+
+    Returns
+    -------
+    list of (str, str)
+        ``(canonical unit, "acceleration" | "velocity")``.
+    """
+    found = []
+    for line in header_lines:
+        matches = [(m.start(), m.group(1)) for m in _BRACKETED.finditer(line)]
+        matches += [(m.start(), m.group(1)) for m in _UNITS_KEY.finditer(line)]
+        for start, candidate in sorted(matches):
+            before = line[:start].split()
+            if before and _PEAK_NAME.match(before[-1].strip(",;:=")):
+                continue
+            unit = _unit_kind(candidate)
+            if unit is not None and unit not in found:
+                found.append(unit)
+    return found
 
 
 def header_units(header_lines) -> str | None:
-    """Find an acceleration unit stated in header lines.
+    """Find the unit of the samples stated in header lines.
 
     Parameters
     ----------
@@ -104,21 +165,13 @@ def header_units(header_lines) -> str | None:
     Returns
     -------
     str or None
-        The canonical unit key (see :func:`shipblock.units.canonical_unit`), or ``None``.
-
-    Raises
-    ------
-    UnitsError
-        Never raised here; conflicting statements are resolved by the caller.
+        The canonical unit key (acceleration, see :func:`shipblock.units.canonical_unit`, or
+        velocity), ``None`` if none is stated, or the units joined by ``|`` if several are.
     """
-    found = []
-    for line in header_lines:
-        candidates = _BRACKETED.findall(line) + _UNITS_KEY.findall(line)
-        for candidate in candidates:
-            key = canonical_unit(candidate)
-            if key is not None and key not in found:
-                found.append(key)
-    return found[0] if len(found) == 1 else (None if not found else "|".join(found))
+    statements = header_unit_statements(header_lines)
+    if len({_factor(*unit) for unit in statements}) == 1:
+        return statements[0][0]  # one unit, perhaps spelled two ways (cm/s^2 and gal)
+    return "|".join(unit for unit, _ in statements) or None
 
 
 def _header_dt(header_lines) -> float | None:
@@ -151,7 +204,7 @@ def is_text(filename) -> bool:
         lines = text.splitlines()
         if len(text) >= 8192 and lines:
             lines = lines[:-1]  # the last line may be cut by the peek window
-        header, rows = _split(lines, "", strict=False)
+        header, rows, _ = _split(lines, "", strict=False)
         if len(rows) < 2 or not header:
             return False
         unit = header_units(header)
@@ -165,22 +218,45 @@ def is_text(filename) -> bool:
         return False
 
 
-def _resolve_units(stated: str | None, found: str | None, name: str) -> str:
-    """Combine the caller's unit with the header's; refuse unknown or conflicting units."""
-    if found is not None and "|" in found:
-        raise UnitsError(name, f"header states several units ({found.replace('|', ', ')})")
-    if stated is None and found is None:
+def _resolve_units(stated: str | None, found: list[tuple[str, str]], name: str):
+    """Combine the caller's unit with the header's; refuse unknown or contradictory units.
+
+    Returns
+    -------
+    unit : str
+        The canonical unit.
+    kind : str
+        ``"acceleration"`` or ``"velocity"``.
+    factor : float
+        Factor to SI (m/s^2 or m/s).
+    """
+    if len({_factor(*unit) for unit in found}) > 1:
+        raise UnitsError(name, "header states contradictory units of the samples ("
+                               + ", ".join(unit for unit, _ in found) + "); give the file one")
+    if stated is None and not found:
         raise UnitsError(
             name,
             "units unknown: a plain text record needs units= (for example 'g', 'm/s^2',"
-            " 'cm/s^2', 'gal') or a header such as '# time (s), accel (g)'",
+            " 'cm/s^2', 'gal'; command line: --units) or a header such as"
+            " '# time (s), accel (g)'",
         )
     if stated is not None:
-        si_factor(stated, name)
-        if found is not None and si_factor(stated, name) != si_factor(found, name):
-            raise UnitsError(name, f"units={stated!r} contradicts the header unit {found!r}")
-        return canonical_unit(stated)
-    return found
+        given = _unit_kind(stated)
+        if given is None:
+            si_factor(stated, name)  # raises, naming the known units
+        if found and _factor(*found[0]) != _factor(*given):
+            raise UnitsError(name, f"units={stated!r} contradicts the header unit {found[0][0]!r}"
+                                   f" ({found[0][1]})")
+        unit, kind = given
+    else:
+        unit, kind = found[0]
+    return unit, kind, _factor(unit, kind)
+
+
+def _factor(unit: str, kind: str) -> tuple[str, float]:
+    """The kind and SI factor of a canonical unit (compared to tell units apart)."""
+    return kind, (ACCELERATION_UNITS_TO_SI[unit] if kind == "acceleration"
+                  else VELOCITY_UNITS_TO_SI[unit])
 
 
 def read_text_record(
@@ -231,21 +307,24 @@ def read_text_record(
         If the units are unknown or contradictory.
     """
     name = source_name(filename)
-    header, rows = _split(read_text(filename).splitlines(), name, strict=True)
+    header, rows, blanks = _split(read_text(filename).splitlines(), name, strict=True)
     if not rows:
         raise RecordError(name, "holds no numeric samples (empty or not a text record)")
     ncols = {len(r) for r in rows}
     if len(ncols) != 1:
         raise RecordError(name, f"rows have different numbers of columns ({sorted(ncols)})")
     (ncol,) = ncols
-    if ncol not in (1, 2):
-        raise RecordError(name, f"has {ncol} columns; expected 1 (accel) or 2 (time, accel)")
-    unit = _resolve_units(units, header_units(header), name)
-    factor = si_factor(unit, name)
+    components = _components(header, name) if ncol == 4 else None
+    if ncol not in (1, 2) and components is None:
+        raise RecordError(name, f"has {ncol} columns; expected 1 (accel), 2 (time, accel) or 4"
+                                " (time and three components named in a header line, such as"
+                                " '# Time (s), NS (cm/s/s), EW (cm/s/s), UD (cm/s/s)')")
+    statements = header_unit_statements(header)
+    notes = _check_quantity_words(header, statements, units, name)
+    unit, kind, (_, factor) = _resolve_units(units, [] if notes else statements, name)
     table = np.asarray(rows, dtype=np.float64)
-    accel = table[:, -1]
     t0 = 0.0
-    if ncol == 2:
+    if ncol >= 2:
         times = table[:, 0]
         if times.size < 2:
             raise RecordError(name, "a two-column record needs at least two samples")
@@ -261,30 +340,93 @@ def read_text_record(
             raise RecordError(name, f"dt={dt} s contradicts the time column step {step:g} s")
         delta, t0 = step, float(times[0])
     else:
+        if blanks:
+            # One column has no time to tell a gap by: a blank line may be a lost sample, and
+            # every later sample would move one interval earlier.
+            raise RecordError(name, f"line {blanks[0]} is blank between samples of a one-column"
+                                    f" record ({len(blanks)} such lines): a sample missing? Remove"
+                                    " the blank lines if none is")
         delta = dt if dt is not None else _header_dt(header)
         if delta is None:
             raise RecordError(name, "one-column record: the sampling interval is unknown; pass dt=")
     delta = check_sampling_interval(delta, name)
     start = UTCDateTime(starttime) if starttime is not None else UTCDateTime(0) + t0
-    stats = {
-        "network": network,
-        "station": station,
-        "location": location,
-        "channel": channel,
-        "starttime": start,
-        "units": "m/s**2",
-        "original_units": unit,
-        "shipblock_text": AttribDict(
-            {"header_lines": header, "columns": ncol, "units": unit, "units_stated_by":
-             "caller" if units is not None else "header"}
-        ),
-    }
-    if headonly:
-        trace = make_trace([], delta, stats)
-        trace.stats.npts = accel.size
-        return Stream([trace])
-    trace = make_trace(accel, delta, stats)
-    check_samples(trace.data, name, "the acceleration column")
-    trace.data *= factor
-    check_plausible_samples(trace.data, name, f"the acceleration column (in {unit})")
-    return Stream([trace])
+    traces = []
+    for column, component in enumerate(components or [{"channel": channel}], start=1):
+        stats = {
+            "network": network,
+            "station": station,
+            "location": location,
+            "starttime": start,
+            "units": "m/s**2" if kind == "acceleration" else "m/s",
+            "original_units": unit,
+            "shipblock_text": AttribDict(
+                {"header_lines": header, "columns": ncol, "units": unit, "units_stated_by":
+                 "caller" if units is not None else "header", "notes": notes}
+            ),
+            **component,
+        }
+        values = table[:, column if components else -1]
+        if headonly:
+            trace = make_trace([], delta, stats)
+            trace.stats.npts = values.size
+        else:
+            trace = make_trace(values, delta, stats)
+            what = f"the {kind} column{f' {column + 1}' if components else ''}"
+            check_samples(trace.data, name, what)
+            trace.data *= factor
+            if kind == "acceleration":
+                check_plausible_samples(trace.data, name, f"{what} (in {unit})")
+        traces.append(trace)
+    return Stream(traces)
+
+
+#: Column names of the components of a multi-column record (SCEC broadband platform ``.bbp``)
+#: -> (vertical, azimuth [deg]).
+_COMPONENT_NAMES = {"NS": (False, 0.0), "N-S": (False, 0.0), "N": (False, 0.0),
+                    "EW": (False, 90.0), "E-W": (False, 90.0), "E": (False, 90.0),
+                    "UD": (True, None), "U-D": (True, None), "UP": (True, None),
+                    "Z": (True, None), "V": (True, None)}
+
+
+def _components(header, name: str):
+    """Channel entries of the three component columns a header line names, or ``None``."""
+    for line in reversed(header):
+        fields = [f.strip() for f in line.lstrip("#%!;/ ").split(",")]
+        if len(fields) != 4:
+            continue
+        words = [re.sub(r"[\(\[].*$", "", f).strip().upper() for f in fields[1:]]
+        if not all(word in _COMPONENT_NAMES for word in words):
+            continue
+        found = [_COMPONENT_NAMES[word] for word in words]
+        if sorted(vertical for vertical, _ in found) != [False, False, True] or len(
+                {azimuth for _, azimuth in found}) != 3:
+            raise RecordError(name, f"the columns {', '.join(words)} are not two horizontals"
+                                    " and a vertical")
+        return [{"channel": f"HN{'Z' if vertical else 'NE'[int(azimuth == 90.0)]}",
+                 "dip": -90.0 if vertical else 0.0,
+                 **({} if vertical else {"azimuth": azimuth})} for vertical, azimuth in found]
+    return None
+
+
+def _check_quantity_words(header, statements, units, name) -> list[str]:
+    """Refuse a header that calls the samples one quantity and gives the unit of another.
+
+    ``# Acceleration time series in units of cm/s`` (pyrotd's ``accel_ts.bbp``) names an
+    acceleration and a velocity unit: one of them is wrong, and only the caller can say which
+    (``units=``, which then decides; said in the returned notes).
+    """
+    text = " ".join(header).lower()
+    says = {q for q, words in (("acceleration", ("acceleration", "accel")),
+                               ("velocity", ("velocity",))) if any(w in text for w in words)}
+    stated_kinds = {k for _, k in statements}
+    if len(says) != 1 or not stated_kinds or says == stated_kinds:
+        return []
+    (word,) = says
+    if units is None:
+        raise UnitsError(name, f"the header calls the samples {word} but states the"
+                               f" {'/'.join(sorted(stated_kinds))} unit"
+                               f" {', '.join(u for u, _ in statements)}: contradictory; state the"
+                               " unit with units= (command line: --units)")
+    return [f"the header calls the samples {word} but states"
+            f" {', '.join(u for u, _ in statements)}; units={units!r} given by the caller used"]

@@ -113,11 +113,14 @@ def expand_sources(source, name: str = "source") -> list[Path]:
                 for path in expand_sources(item, f"{name}[{i}]")]
     path = checks.pathname(source, name, _SOURCE)
     if os.path.isdir(path):
-        return sorted(p for p in Path(path).rglob("*") if p.is_file() and not p.name.startswith("."))
+        # Broken symbolic links are listed too: reading them names them (not skipped silently).
+        return sorted(p for p in Path(path).rglob("*") if not p.name.startswith(".")
+                      and (p.is_file() or (p.is_symlink() and not p.exists())))
     if os.path.isfile(path):
         return [Path(path)]
     if globbing.has_magic(path):
-        matches = sorted(Path(p) for p in globbing.glob(path, recursive=True) if os.path.isfile(p))
+        matches = sorted(Path(p) for p in globbing.glob(path, recursive=True)
+                         if os.path.isfile(p) or (os.path.islink(p) and not os.path.exists(p)))
         if not matches:
             raise RecordError(path, f"the pattern matches no file ({name} must name {_SOURCE})")
         return matches

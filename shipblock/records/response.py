@@ -19,7 +19,7 @@ import numpy as np
 from obspy import Trace
 
 from shipblock.errors import ParameterError, RecordError, UnitsError
-from shipblock.io import check_count_value
+from shipblock.io import check_count_value, sensitivity_sign
 from shipblock.records.motion import SI_UNITS, trace_source
 from shipblock.records.sensors import orientation_letter
 from shipblock.units import (
@@ -34,7 +34,7 @@ __all__ = ["CALIB_IN_SI_FORMATS", "to_si"]
 
 #: Formats whose ``stats.calib`` (set by obspy from the file header) is m/s^2 per count.
 CALIB_IN_SI_FORMATS = {
-    "KNET": "K-NET scale factor",
+    "KNET": "K-NET scale factor; the digitiser offset, the record's mean, removed as NIED states",
     "KINEMETRICS_EVT": "Kinemetrics EVT full scale and sensitivity",
 }
 
@@ -106,10 +106,8 @@ def _by_sensitivity(trace, response, source_label, differentiate, name, note="")
     if quantity is not None:
         check_count_value(factor / value, name, f"{source_label}: channel {trace.id}'s sensitivity"
                                                 f" {value:.6g} counts/({input_units})")
-    if value < 0:
-        # A negative sensitivity states a channel wired with reversed polarity (BK.VALB HN3 in
-        # real BK metadata): dividing by it restores the ground's sign.
-        note += " (negative: the channel's polarity is reversed and is restored)"
+    # A negative sensitivity: a reversed channel if its stages agree, refused if they do not.
+    note += sensitivity_sign(response, name, f"{source_label}: channel {trace.id}")
     if quantity is None:
         raise UnitsError(
             name, f"{source_label}: channel {trace.id} senses {input_units or 'unknown units'},"
@@ -197,11 +195,18 @@ def to_si(trace: Trace, inventory, inventory_name, units, response, differentiat
                                   != ACCELERATION_UNITS_TO_SI[key]):
             raise UnitsError(name, f"units={units!r} contradicts the file's own unit {original!r}")
         return f"{original} -> m/s**2 from the file header ({fmt or 'stream'})"
-    if current == "m/s" and units is None:
-        how = f"{stats.get('original_units', 'm/s')} -> m/s from the file header ({fmt})"
+    given_by_reader = (units is not None and current == "m/s" and canonical_velocity_unit(units)
+                       == canonical_velocity_unit(str(stats.get("original_units", ""))))
+    if current == "m/s" and (units is None or given_by_reader):
+        # A text reader already applied the caller's velocity unit (units='cm/s').
+        origin = "the caller's units=" if given_by_reader else f"the file header ({fmt})"
+        how = f"{stats.get('original_units', 'm/s')} -> m/s from {origin}"
         how = _differentiate(trace, how, differentiate, name, "the file states velocity")
         stats.units = SI_UNITS
         return how
+    if current == "m/s":
+        raise UnitsError(name, f"units={units!r} contradicts the file's own unit"
+                               f" {stats.get('original_units', 'm/s')!r} (a velocity)")
     if current not in (None, "counts"):
         raise UnitsError(name, f"channel {trace.id} has unsupported units {current!r}")
 

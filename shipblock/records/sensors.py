@@ -81,10 +81,12 @@ def sensor_code(trace: Trace) -> str:
     """``"<location>.<band+instrument>"`` of a trace, e.g. ``"02.HN"``: one sensor of a station.
 
     Only SEED channel codes (three characters, band and instrument letters first) name a sensor;
-    other codes (an AT2 file's ``"180"``, an EVT file's ``"0"``) leave it empty.
+    other codes (an AT2 file's ``"180"`` or ``"DWN"``, marked by its reader with
+    ``stats.seed_channel = False``; an EVT file's ``"0"``) leave it empty.
     """
     channel = trace.stats.channel
-    code = channel[:2] if len(channel) == 3 and channel[:2].isalpha() else ""
+    seed = trace.stats.get("seed_channel", True) and len(channel) == 3 and channel[:2].isalpha()
+    code = channel[:2] if seed else ""
     return f"{trace.stats.location}.{code}"
 
 
