@@ -172,24 +172,23 @@ def test_interleaved_times_alternate_the_calls_on_their_threads():
     assert numba.get_num_threads() == before
 
 
-def test_control_loop_lasts_about_what_was_asked():
-    """The control loop is calibrated to the requested length (loosely: machines vary)."""
-    import time
+def test_control_loop_is_calibrated_to_the_requested_length(monkeypatch):
+    """The control loop's calibration, on a clock that the loop itself advances (1e-8 s per
+    iteration): it lasts what was asked. Wall-clock lengths belong to ``shipblock bench``, not to
+    a unit test on a shared machine (a timed test fails by chance under load)."""
+    clock = {"now": 0.0}
+    per_iteration = 1e-8
 
-    import numba
+    def spin(n, out):
+        clock["now"] += n * per_iteration
 
-    loop = timing.control_loop(0.02)
-    threads = numba.get_num_threads()
-    numba.set_num_threads(1)
-    try:
-        took = []
-        for _ in range(5):
-            t0 = time.perf_counter()
-            loop()
-            took.append(time.perf_counter() - t0)
-    finally:
-        numba.set_num_threads(threads)
-    assert 0.005 < min(took) < 0.08
+    monkeypatch.setattr(timing, "_spin", spin)
+    monkeypatch.setattr(timing.time, "perf_counter", lambda: clock["now"])
+    for seconds in (0.02, 0.5):
+        loop = timing.control_loop(seconds)
+        t0 = clock["now"]
+        loop()
+        assert clock["now"] - t0 == pytest.approx(seconds, rel=1e-6)
 
 
 def test_throughput_reports_best_and_median_of_its_window():
