@@ -124,29 +124,80 @@ def _add_record_arguments(p):
     g.add_argument("--record", help="id of a catalogue record, e.g. NP.1765 or south-napa-2014/NP.1765")
     g.add_argument("--catalogue", help="record catalogue TOML (default: the shipped one)")
     _add_conversion_arguments(g)
-    g.add_argument("--sensor", help="sensor to use when a station has several: LOC.CODE, e.g."
-                                    " 02.HN (KiK-net surface) or HN")
     g.add_argument("--azimuth", type=float,
                    help="dock transverse axis [deg clockwise from north]: horizontals rotated to it")
-    g.add_argument("--horizontal", choices=["H1", "H2"], help="use this horizontal component")
+    g.add_argument("--horizontal", choices=["H1", "H2"],
+                   help="use this horizontal component (default H1, the record's first"
+                        " horizontal; see docs/user_guide/records.rst)")
     g.add_argument("--processing", default="default",
                    help="'default' (the documented chain), 'demean', 'none', or a TOML file with "
                         "[[processing]] steps")
 
 
 def _add_conversion_arguments(g):
+    """The read options of shipblock.read_motion, one flag each (shipblock.checks.READ_OPTIONS
+    names them, and the catalogue key of each)."""
     g.add_argument("--inventory", help="StationXML for raw counts (and channel orientations)")
     g.add_argument("--units", help="units of records that do not state them: m/s^2, cm/s^2, gal,"
                                    " g, or velocity m/s, cm/s (with --differentiate)")
-    g.add_argument("--response", choices=["sensitivity", "full"], default="sensitivity",
+    g.add_argument("--response", choices=["sensitivity", "full"],
                    help="with --inventory: divide by the overall sensitivity (default) or remove"
                         " the full instrument response")
-    g.add_argument("--differentiate", action="store_true",
+    g.add_argument("--differentiate", action="store_true", default=None,
                    help="differentiate velocity records to acceleration (said in the provenance)")
+    g.add_argument("--channel-map", action="append", metavar="CHANNEL=COMPONENT",
+                   help="component of a channel the file does not name (channel code, SEED id or"
+                        " file name = H1, H2 or V), e.g. --channel-map 0=H1 --channel-map 3=H2"
+                        " or --channel-map 0=H1,3=H2,4=V (Kinemetrics EVT); unmapped channels"
+                        " are left out")
+    g.add_argument("--sensor", help="sensor to use when a station has several: LOC.CODE, e.g."
+                                    " 02.HN (KiK-net surface) or HN")
+    g.add_argument("--align", choices=["trim", "resample", "strict"],
+                   help="components of different windows or sampling rates: trim to the common"
+                        " window (default), resample to the lowest rate, or refuse (strict)")
+    g.add_argument("--gaps", choices=["refuse", "interpolate"],
+                   help="gaps inside a channel: refuse (default) or fill short ones linearly")
+    g.add_argument("--event", metavar="QUAKEML", help="the earthquake (QuakeML file)")
+    g.add_argument("--input-format", dest="read_format", metavar="FORMAT",
+                   help="obspy format name of the files (default: detected), e.g. SHIPBLOCK_TEXT")
+    g.add_argument("--dt", type=float, metavar="SECONDS",
+                   help="sampling interval of one-column text records [s]")
+    g.add_argument("--data-type", choices=["acceleration"],
+                   help="state what an SMC file whose header says '0 UNKNOWN' holds (only"
+                        " acceleration, in the format's cm/s^2, can be read)")
 
 
-def _conversion_kwargs(args) -> dict:
-    return {"response": args.response, "differentiate": args.differentiate}
+def _channel_map(items) -> dict | None:
+    """``["0=H1,3=H2", "4=V"]`` -> ``{"0": "H1", "3": "H2", "4": "V"}`` (``--channel-map``)."""
+    if not items:
+        return None
+    mapping = {}
+    for item in items:
+        for part in item.split(","):
+            channel, sep, component = part.partition("=")
+            if not sep or not channel.strip() or component.strip() not in ("H1", "H2", "V"):
+                raise UserError(f"--channel-map expects CHANNEL=H1, CHANNEL=H2 or CHANNEL=V"
+                                f" (comma-separated or repeated), got {part!r}")
+            mapping[channel.strip()] = component.strip()
+    return mapping
+
+
+#: The read options of _add_conversion_arguments: read_motion keyword -> attribute of args.
+_READ_OPTION_ARGS = {"inventory": "inventory", "units": "units", "response": "response",
+                     "differentiate": "differentiate", "sensor": "sensor", "align": "align",
+                     "gaps": "gaps", "event": "event", "format": "read_format", "dt": "dt",
+                     "data_type": "data_type"}
+
+
+def _read_options(args) -> dict:
+    """The read options given on the command line (only those given: the others keep the
+    library's defaults, or a catalogue entry's keys)."""
+    options = {key: getattr(args, attr) for key, attr in _READ_OPTION_ARGS.items()
+               if getattr(args, attr, None) is not None}
+    channel_map = _channel_map(getattr(args, "channel_map", None))
+    if channel_map:
+        options["channel_map"] = channel_map
+    return options
 
 
 def _find_entry(record_id, catalogue):
@@ -195,7 +246,7 @@ def _load_motion(args):
     if args.record:
         entry = _find_entry(args.record, args.catalogue)
         motion = entry.read(azimuth=args.azimuth, horizontal=args.horizontal,
-                            **_conversion_kwargs(args))
+                            **_read_options(args))
     elif args.files:
         import glob
 
@@ -203,9 +254,8 @@ def _load_motion(args):
             if not Path(f).exists() and not glob.has_magic(f):
                 raise UserError(f"{f}: no such file")
         motion = read_motion(args.files if len(args.files) > 1 else args.files[0],
-                             inventory=args.inventory, units=args.units, azimuth=args.azimuth,
-                             horizontal=args.horizontal, sensor=args.sensor,
-                             **_conversion_kwargs(args))
+                             azimuth=args.azimuth, horizontal=args.horizontal,
+                             **_read_options(args))
     else:
         raise UserError("no record: give record files or --record ID (see 'shipblock info --help')")
     chain = _processing_chain(args.processing)
@@ -423,15 +473,15 @@ def cmd_catalogue(args):
     from shipblock.records.catalogue import catalogue_toml, load_catalogue
     from shipblock.records.folders import read_motions
 
-    found = read_motions(args.sources, inventory=args.inventory, units=args.units,
-                         **_conversion_kwargs(args))
+    options = _read_options(args)
+    found = read_motions(args.sources, **options)
     for where, why in found.failures:
         log.warning("not used: %s: %s", where, why)
     if not found.motions:
         raise UserError(f"no record could be read from {', '.join(args.sources)}"
                         f" ({len(found.failures)} failures listed above)")
     text = catalogue_toml(found, args.output, licence=args.license, credit=args.credit,
-                          units=args.units)
+                          options=options)
     output = Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     partial = output.with_name(output.name + ".part")
@@ -630,7 +680,7 @@ def build_parser():
                        " that cannot be read are listed with their reasons.")
     s.add_argument("sources", nargs="+", help="folders, glob patterns or files")
     s.add_argument("--output", "-o", default="catalogue.toml", help="catalogue TOML to write")
-    g = s.add_argument_group("conversion")
+    g = s.add_argument_group("reading (stored in each entry, so that it reads back the same)")
     _add_conversion_arguments(g)
     s.add_argument("--license", "--licence", dest="license", help="licence of the records")
     s.add_argument("--credit", help="credit line of the records")

@@ -46,6 +46,7 @@ from shipblock.errors import ParameterError, ParameterTypeError, RecordError, Sh
 from shipblock.io import at2, bhrc, cosmos, cwb, dmg, esm, geonet, nsmn, renadic, smc, text, unam, usc
 from shipblock.io._common import (
     MAX_DIGITIZATION_GAP_S,
+    UNITS_GIVEN_KEY,
     check_count_value,
     check_plausible_samples,
     check_sampling_interval,
@@ -59,6 +60,7 @@ from shipblock.io.knet import normalise_knet
 __all__ = [
     "FORMATS",
     "MAX_DIGITIZATION_GAP_S",
+    "UNITS_GIVEN_KEY",
     "check_count_value",
     "check_format",
     "check_plausible_samples",
@@ -218,7 +220,8 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
         Acceleration unit of a plain text file (passed to the ``SHIPBLOCK_TEXT`` reader only);
         any unit :func:`shipblock.checks.unit` knows.
     **kwargs
-        Passed to the reader: ``dt`` [s] for a one-column text file, ``resample_rate`` [Hz] for
+        Passed to the reader: ``dt`` [s] for a one-column text file, ``data_type``
+        (``"acceleration"``) for an SMC file whose header says ``0 UNKNOWN``, ``resample_rate`` [Hz] for
         SMC and USC files, ``resample_interval`` [s] for DMG files (each checked: an interval
         within 1e-4..1 s, a rate within 1..1e4 Hz), or obspy's own keywords.
 
@@ -250,6 +253,8 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
     for key, check in _NUMERIC_KEYWORDS.items():
         if kwargs.get(key) is not None:
             kwargs[key] = check(kwargs[key], key)
+    if kwargs.get("data_type") is not None:
+        checks.choice(kwargs["data_type"], "data_type", smc.STATED_DATA_TYPES)
     if format == text.FORMAT:
         kwargs["units"] = units
     with warnings.catch_warnings(record=True) as caught:

@@ -23,7 +23,9 @@ from obspy import Stream, UTCDateTime
 from obspy.core import AttribDict
 
 from shipblock.errors import RecordError, UnitsError
+from shipblock.checks import how_to_pass
 from shipblock.io._common import (
+    UNITS_GIVEN_KEY,
     check_plausible_samples,
     check_samples,
     check_sampling_interval,
@@ -33,7 +35,7 @@ from shipblock.io._common import (
     read_text,
     source_name,
 )
-from shipblock.units import canonical_unit, si_factor
+from shipblock.units import VELOCITY_UNITS_TO_SI, canonical_unit, canonical_velocity_unit, si_factor
 
 __all__ = ["FORMAT", "TIME_STEP_TOLERANCE", "is_text", "read_text_record"]
 
@@ -172,9 +174,15 @@ def _resolve_units(stated: str | None, found: str | None, name: str) -> str:
     if stated is None and found is None:
         raise UnitsError(
             name,
-            "units unknown: a plain text record needs units= (for example 'g', 'm/s^2',"
-            " 'cm/s^2', 'gal') or a header such as '# time (s), accel (g)'",
+            "units unknown: a plain text record needs a header such as '# time (s), accel (g)'"
+            " or " + how_to_pass("units", "UNIT", placeholder=True) + ", UNIT for example g,"
+            " m/s^2, cm/s^2, gal (or m/s, cm/s for velocity, with --differentiate)",
         )
+    if stated is not None and canonical_velocity_unit(stated) is not None:
+        if found is not None:
+            raise UnitsError(name, f"units={stated!r} (a velocity) contradicts the header unit"
+                                   f" {found!r}")
+        return canonical_velocity_unit(stated)
     if stated is not None:
         si_factor(stated, name)
         if found is not None and si_factor(stated, name) != si_factor(found, name):
@@ -205,7 +213,9 @@ def read_text_record(
         Read only the header (the samples are parsed anyway to know their number).
     units : str, optional
         Unit of the acceleration column (``"g"``, ``"m/s^2"``, ``"cm/s^2"``, ``"gal"``, ...);
-        required unless the header states it.
+        required unless the header states it. A velocity unit (``"m/s"``, ``"cm/s"``) reads a
+        velocity record: the trace is then in m/s (``stats.units == "m/s"``), to be
+        differentiated (``read_motion(..., differentiate=True)``).
     dt : float, optional
         Sampling interval [s]; required for one-column files without a ``dt =`` header line;
         checked against the time column of two-column files.
@@ -240,8 +250,10 @@ def read_text_record(
     (ncol,) = ncols
     if ncol not in (1, 2):
         raise RecordError(name, f"has {ncol} columns; expected 1 (accel) or 2 (time, accel)")
-    unit = _resolve_units(units, header_units(header), name)
-    factor = si_factor(unit, name)
+    stated_by_header = header_units(header)
+    unit = _resolve_units(units, stated_by_header, name)
+    velocity = canonical_velocity_unit(unit) is not None
+    factor = VELOCITY_UNITS_TO_SI[unit] if velocity else si_factor(unit, name)
     table = np.asarray(rows, dtype=np.float64)
     accel = table[:, -1]
     t0 = 0.0
@@ -263,7 +275,8 @@ def read_text_record(
     else:
         delta = dt if dt is not None else _header_dt(header)
         if delta is None:
-            raise RecordError(name, "one-column record: the sampling interval is unknown; pass dt=")
+            raise RecordError(name, "one-column record: the sampling interval is unknown; "
+                                    + how_to_pass("dt", "SECONDS", placeholder=True))
     delta = check_sampling_interval(delta, name)
     start = UTCDateTime(starttime) if starttime is not None else UTCDateTime(0) + t0
     stats = {
@@ -272,8 +285,9 @@ def read_text_record(
         "location": location,
         "channel": channel,
         "starttime": start,
-        "units": "m/s**2",
+        "units": "m/s" if velocity else "m/s**2",
         "original_units": unit,
+        UNITS_GIVEN_KEY: stated_by_header is None,
         "shipblock_text": AttribDict(
             {"header_lines": header, "columns": ncol, "units": unit, "units_stated_by":
              "caller" if units is not None else "header"}
@@ -286,5 +300,6 @@ def read_text_record(
     trace = make_trace(accel, delta, stats)
     check_samples(trace.data, name, "the acceleration column")
     trace.data *= factor
-    check_plausible_samples(trace.data, name, f"the acceleration column (in {unit})")
+    if not velocity:
+        check_plausible_samples(trace.data, name, f"the acceleration column (in {unit})")
     return Stream([trace])

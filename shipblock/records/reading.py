@@ -75,10 +75,12 @@ def _names_many(source) -> bool:
 
 
 def _one_of_folder(source, inventory, units, response, differentiate, align, gaps, event,
-                   azimuth, horizontal, sensor) -> GroundMotion:
+                   azimuth, horizontal, sensor, channel_map, format,  # noqa: A002
+                   read_kwargs) -> GroundMotion:
     """The single record (of ``sensor``, if given) of a folder or glob; refuse several."""
     found = read_motions(source, inventory=inventory, units=units, response=response,
-                         differentiate=differentiate, align=align, gaps=gaps, event=event)
+                         differentiate=differentiate, align=align, gaps=gaps, event=event,
+                         channel_map=channel_map, format=format, **read_kwargs)
     motions = found.motions
     if sensor is not None:
         motions = [m for m in motions if len(select_sensor(m.stream, sensor, None, strict=False))]
@@ -96,7 +98,7 @@ def _one_of_folder(source, inventory, units, response, differentiate, align, gap
             label,
             f"holds {len(motions)} records ("
             + ", ".join(next(iter(m.metadata["channels"].values()))[:-1] for m in motions)
-            + "); choose one with sensor= (command line: --sensor) or name its files;"
+            + "); choose one: " + checks.how_to_pass("sensor", "HN") + ", or name its files;"
             " read_motions() (command line: shipblock catalogue) reads them all" + failures,
         )
     motion = motions[0]
@@ -212,7 +214,8 @@ def read_motion(
     paths_or_stream = _check_sources(paths_or_stream)
     if _names_many(paths_or_stream):
         return _one_of_folder(paths_or_stream, inventory, units, response, differentiate, align,
-                              gaps, event, azimuth, horizontal, sensor)
+                              gaps, event, azimuth, horizontal, sensor, channel_map, format,
+                              read_kwargs)
     stream = load_stream(paths_or_stream, units, format, read_kwargs)
     return assemble_motion(stream, inventory=inventory, units=units, response=response,
                            differentiate=differentiate, align=align, gaps=gaps, event=event,

@@ -17,6 +17,7 @@ from collections.abc import Mapping
 import numpy as np
 from obspy import Stream, Trace
 
+from shipblock.checks import how_to_pass
 from shipblock.errors import ParameterError, RecordError
 from shipblock.records.motion import COMPONENT_KEY, COMPONENTS, ORIENTATION_TOLERANCE, trace_source
 
@@ -106,7 +107,7 @@ def select_sensor(stream: Stream, sensor: str | None, channel_map, strict: bool 
             "the files hold several sensors of one station: "
             + ", ".join(f"{code} ({', '.join(tr.stats.channel for tr in stream if sensor_code(tr) == code)})"
                         for code in sensors)
-            + "; choose one with sensor='<location>.<code>' (command line: --sensor)",
+            + "; choose one: " + how_to_pass("sensor", next(iter(sensors)).lstrip(".")),
         )
     wanted = sensor.strip().upper()
     chosen = Stream([tr for tr in stream if sensor_code(tr).upper() == wanted
@@ -166,7 +167,7 @@ def assign_components(
                 label,
                 "traces of several stations/locations: "
                 + ", ".join(".".join(s) for s in sorted(stations))
-                + "; pass channel_map= to choose",
+                + f"; {how_to_pass('channel_map', None)}",
             )
         verticals = [tr for tr in stream if info[id(tr)][0] == "V"]
         horizontals = [tr for tr in stream if info[id(tr)][0] == "H"]
@@ -184,12 +185,14 @@ def assign_components(
                     label,
                     "cannot tell the component of "
                     + ", ".join(f"{tr.id} ({trace_source(tr)})" for tr in unknown)
-                    + "; pass channel_map={'<channel or file>': 'H1'|'H2'|'V'}",
+                    + f"; {how_to_pass('channel_map', None)}",
                 )
         if len(verticals) > 1:
-            raise RecordError(label, f"{len(verticals)} vertical channels; pass channel_map=")
+            raise RecordError(label, f"{len(verticals)} vertical channels;"
+                                    f" {how_to_pass('channel_map', None)}")
         if len(horizontals) > 2:
-            raise RecordError(label, f"{len(horizontals)} horizontal channels; pass channel_map=")
+            raise RecordError(label, f"{len(horizontals)} horizontal channels;"
+                                    f" {how_to_pass('channel_map', None)}")
         if len(horizontals) == 2:
             horizontals = _order_horizontals(horizontals, info)
         for component, trace in zip(("H1", "H2"), horizontals, strict=False):
