@@ -470,7 +470,7 @@ def cmd_info(args):
 
 
 def cmd_catalogue(args):
-    from shipblock.records.catalogue import catalogue_toml, load_catalogue
+    from shipblock.records.catalogue import catalogue_toml, load_catalogue, record_id
     from shipblock.records.folders import read_motions
 
     options = _read_options(args)
@@ -497,7 +497,7 @@ def cmd_catalogue(args):
     for motion in found.motions:
         peaks = "  ".join(f"{c} {abs(a).max() / STANDARD_GRAVITY:.4f} g"
                           for c, a in motion.components.items())
-        sensor = next(iter(motion.metadata.get("channels", {}).values()), motion.name)[:-1]
+        sensor = record_id(motion)
         sys.stdout.write(f"  {sensor:<20} dt {motion.dt:g} s  {motion.npts:>7} samples  {peaks}\n")
     return 0
 
@@ -506,13 +506,14 @@ def cmd_process(args):
     import csv
 
     from shipblock import intensity
+    from shipblock.records.catalogue import record_file_stem
 
     motion = _load_motion(args)
     outdir = Path(args.output_dir)
     outdir.mkdir(parents=True, exist_ok=True)
     st = motion.stream.copy()
     name = motion.name
-    stem = name.replace("/", "_")
+    stem = record_file_stem(name)
     fmt = args.format.upper()
     ext = {"MSEED": "mseed", "SAC": "sac"}[fmt]
     written = []
