@@ -238,8 +238,20 @@ def _processing_chain(spec):
 
 
 def _load_motion(args):
-    from shipblock.records.reading import read_motion
+    """The record of the command line, processed as --processing says."""
+    return _processed(_read_record(args), args)
+
+
+def _processed(motion, args):
     from shipblock.processing import process_motion
+
+    chain = _processing_chain(args.processing)
+    return process_motion(motion, chain) if chain else motion
+
+
+def _read_record(args):
+    """The record of the command line as read (converted to m/s^2, not processed)."""
+    from shipblock.records.reading import read_motion
 
     if args.record and args.files:
         raise UserError("give either --record or record files, not both")
@@ -258,10 +270,23 @@ def _load_motion(args):
                              **_read_options(args))
     else:
         raise UserError("no record: give record files or --record ID (see 'shipblock info --help')")
-    chain = _processing_chain(args.processing)
-    if chain:
-        motion = process_motion(motion, chain)
     return motion
+
+
+def _horizontal_line(motion) -> str:
+    """Which horizontal the solver uses, and by which rule."""
+    from shipblock.records.sensors import HORIZONTAL_RULE
+
+    chosen = motion.metadata.get("horizontal", "H1")
+    if chosen not in ("H1", "H2"):
+        return f"{chosen} (--azimuth)"
+    channel = motion.metadata.get("channels", {}).get(chosen, "")
+    azimuth = motion.azimuths.get(chosen)
+    where = ", ".join(x for x in (channel.strip("."), "" if azimuth is None
+                                  else f"azimuth {azimuth:g} deg") if x)
+    how = ("chosen with --horizontal" if motion._horizontal is not None
+           else f"the default (--horizontal H2 or --azimuth DEG to change)\n  rule: {HORIZONTAL_RULE}")
+    return f"{chosen}{f' ({where})' if where else ''}, {how}"
 
 
 # --------------------------------------------------------------------------- subcommands
@@ -283,6 +308,7 @@ def cmd_simulate(args):
     if motion.vertical is not None and not args.no_vertical:
         ay = motion.vertical * (args.scale if args.vertical_scale is None else args.vertical_scale)
     log.info("simulating %d samples at dt = %g s", ax.size, motion.dt)
+    sys.stdout.write(f"horizontal  {_horizontal_line(motion)}\n")
     res = simulate(system, ax, ay, motion.dt, rtol=args.rtol)
     name = motion.name
     _report(res, name, args.events)
@@ -437,7 +463,8 @@ def cmd_info(args):
 
     from shipblock import intensity
 
-    motion = _load_motion(args)
+    raw = _read_record(args)
+    motion = _processed(raw, args)
     out = sys.stdout
     md = motion.metadata
     site = (md.get("catalogue") or {}).get("site", "")
@@ -453,17 +480,35 @@ def cmd_info(args):
             out.write(f"units {comp:<5} {note}\n")
     elif units:
         out.write(f"units       {units}\n")
-    out.write("component  azimuth   PGA [g]   PGV [cm/s]  Arias [m/s]  CAV [m/s]  D5-95 [s]\n")
+    processed = motion is not raw
+    stated = {tr.stats.get("motion_component"): tr.stats.get("stated_peak_si")
+              for tr in raw.stream}
+    out.write("PGA [g]: 'as read' is after unit conversion only"
+              + (", 'processed' after the processing below" if processed else "")
+              + ("; 'file states' is the peak the file's header states" if any(stated.values())
+                 else "") + "\n")
+    out.write("component  azimuth  as read" + ("  processed" if processed else "")
+              + ("  file states" if any(stated.values()) else "")
+              + f"  {'(processed) ' if processed else ''}PGV [cm/s]  Arias [m/s]  CAV [m/s]"
+                "  D5-95 [s]\n")
     for comp, acc in motion.components.items():
         im = intensity.intensity_measures(acc, motion.dt, periods=(0.2, 1.0))
         az = motion.azimuths.get(comp)
-        out.write(f"{comp:<10} {'' if az is None else f'{az:7.1f}':>7}  {im['pga'] / STANDARD_GRAVITY:8.4f}"
-                  f"  {100 * im['pgv']:10.3f}  {im['arias']:11.4f}  {im['cav']:9.4f}"
-                  f"  {im['d5_95']:9.2f}\n")
+        row = (f"{comp:<10} {'' if az is None else f'{az:7.1f}':>7}"
+               f"  {np.abs(raw.components[comp]).max() / STANDARD_GRAVITY:7.4f}")
+        if processed:
+            row += f"  {im['pga'] / STANDARD_GRAVITY:9.4f}"
+        if any(stated.values()):
+            peak = stated.get(comp)
+            row += f"  {'' if peak is None else f'{peak / STANDARD_GRAVITY:11.4f}':>11}"
+        out.write(row + f"  {100 * im['pgv']:10.3f}  {im['arias']:11.4f}  {im['cav']:9.4f}"
+                        f"  {im['d5_95']:9.2f}\n")
     h = motion.horizontal
     sa = intensity.spectral_acceleration(h, motion.dt, np.array([0.2, 1.0]), 0.05)
-    out.write(f"horizontal used by the solver: PGA {np.abs(h).max() / STANDARD_GRAVITY:.4f} g, "
-              f"Sa(0.2 s) {sa[0] / STANDARD_GRAVITY:.4f} g, Sa(1 s) {sa[1] / STANDARD_GRAVITY:.4f} g\n")
+    out.write(f"horizontal used by the solver: {_horizontal_line(motion)}\n")
+    out.write(f"  {'processed: ' if processed else ''}PGA {np.abs(h).max() / STANDARD_GRAVITY:.4f}"
+              f" g, Sa(0.2 s) {sa[0] / STANDARD_GRAVITY:.4f} g,"
+              f" Sa(1 s) {sa[1] / STANDARD_GRAVITY:.4f} g\n")
     for note in md.get("processing", []) or []:
         out.write(f"processing  {note}\n")
     return 0

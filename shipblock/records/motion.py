@@ -4,7 +4,8 @@
 whose traces are tagged with :data:`COMPONENT_KEY`) and the provenance of every conversion in
 ``metadata``; :func:`read_motion` (:mod:`shipblock.records.reading`) builds one from files,
 :meth:`GroundMotion.from_arrays` from arrays. Component conventions: H1 and H2 are the
-horizontals (``H2`` normally 90 deg clockwise from ``H1``), V the vertical, positive up. Azimuths
+horizontals (H1 the record's first, which the solver uses by default:
+:data:`shipblock.records.sensors.HORIZONTAL_RULE`), V the vertical, positive up. Azimuths
 are in degrees clockwise from north.
 """
 

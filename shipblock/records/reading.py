@@ -16,9 +16,10 @@ sampling rate, and returns a :class:`GroundMotion`. All conversions are recorded
   SAC files are multiplied by their ``scale`` header (``stats.calib``) first;
 * a trace whose unit stays unknown raises :class:`~shipblock.errors.UnitsError` naming the file.
 
-Component conventions: H1 and H2 are the horizontals (``H2`` normally 90 deg clockwise from
-``H1``), V the vertical, positive up (a vertical recorded positive down is flipped). Azimuths are
-in degrees clockwise from north.
+Component conventions: H1 and H2 are the horizontals (H1 the record's first, used by the solver
+unless ``horizontal=`` or ``azimuth=`` says otherwise:
+:data:`~shipblock.records.sensors.HORIZONTAL_RULE`), V the vertical, positive up (a vertical
+recorded positive down is flipped). Azimuths are in degrees clockwise from north.
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ from shipblock.checks import how_to_pass
 from shipblock.errors import ParameterError, RecordError
 from shipblock.records.motion import COMPONENT_KEY, COMPONENTS, ORIENTATION_TOLERANCE, trace_source
 
-__all__ = ["assign_components", "orientation_letter", "select_sensor", "sensor_code"]
+__all__ = ["HORIZONTAL_RULE", "assign_components", "orientation_letter", "select_sensor", "sensor_code"]
 
 _TWO_LETTER = {"NS": "N", "EW": "E", "UD": "Z"}
 
@@ -231,13 +231,27 @@ def assign_components(
     return assigned
 
 
+#: How H1 and H2 are told apart when the channels are not mapped (``channel_map``); the solver
+#: uses H1 unless told otherwise (``horizontal=``, ``azimuth=``). Printed by ``shipblock info``
+#: and ``simulate`` and documented in docs/user_guide/records.rst.
+HORIZONTAL_RULE = (
+    "H1 is the record's first horizontal: N before E and 1 before 2 by the channel codes'"
+    " last letters; otherwise the first in the file (a file holding all components, e.g. a"
+    " CSMIP V2), or, for one file per component, the one the other is 90 deg clockwise from"
+    " (PEER 000/090: 000), else the first file given"
+)
+
+
 def _order_horizontals(horizontals, info):
+    """H1 first (:data:`HORIZONTAL_RULE`)."""
     letters = [orientation_letter(tr.stats.channel) for tr in horizontals]
     for first, second in (("N", "E"), ("1", "2")):
         if set(letters) == {first, second}:
             return sorted(
                 horizontals, key=lambda tr: orientation_letter(tr.stats.channel) != first
             )
+    if trace_source(horizontals[0]) == trace_source(horizontals[1]):
+        return list(horizontals)  # one file: its order
     az = [info[id(tr)][1] for tr in horizontals]
     if None not in az:
         separation = (az[1] - az[0]) % 360.0
