@@ -19,11 +19,11 @@ from shipblock.units import STANDARD_GRAVITY
 log = logging.getLogger("shipblock")
 
 SYSTEM_FLAGS = {
-    "ship_mass": ("--ship-mass", float, "ship mass M [kg]"),
-    "block_mass": ("--block-mass", float, "mass of one keel block m [kg]"),
+    "ship_mass": ("--ship-mass", str, "ship mass M: kg, or with a unit: '20000 t'"),
+    "block_mass": ("--block-mass", str, "mass of one keel block m: kg, or with a unit: '4 t'"),
     "n_blocks": ("--n-blocks", int, "number of keel blocks n"),
-    "half_width": ("--half-width", float, "block half width B [m]"),
-    "half_height": ("--half-height", float, "block half height H [m]"),
+    "half_width": ("--half-width", str, "block half width B: m, or with a unit: 600mm"),
+    "half_height": ("--half-height", str, "block half height H: m, or with a unit: 750mm"),
     "mu_s_ground": ("--mu-s-ground", float, "static friction blocks/ground"),
     "mu_k_ground": ("--mu-k-ground", float, "kinetic friction blocks/ground"),
     "mu_s_ship": ("--mu-s-ship", float, "static friction blocks/ship"),
@@ -291,11 +291,21 @@ def _horizontal_line(motion) -> str:
 
 # --------------------------------------------------------------------------- subcommands
 def _system_from_args(args):
-    from shipblock.system import ShipBlockSystem
+    """The system of --system and the system flags; quantities with units converted to SI
+    (shipblock.quantities), and a warning for a system outside any dock
+    (shipblock.system.warn_implausible)."""
+    from shipblock.quantities import to_si
+    from shipblock.system import FIELD_UNITS, ShipBlockSystem, warn_implausible
 
     system = ShipBlockSystem.from_toml(args.system) if args.system else ShipBlockSystem.example()
     changes = {k: getattr(args, k) for k in SYSTEM_FLAGS if getattr(args, k) is not None}
-    return system.replace(**changes) if changes else system
+    changes = {k: to_si(v, FIELD_UNITS[k], SYSTEM_FLAGS[k][0]) if k in FIELD_UNITS else v
+               for k, v in changes.items()}
+    if not changes:
+        return system
+    system = system.replace(**changes)
+    warn_implausible(system, "the command line's system")
+    return system
 
 
 def cmd_simulate(args):
