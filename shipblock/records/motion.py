@@ -23,7 +23,8 @@ from shipblock.errors import ParameterError, ParameterTypeError, RecordError, Un
 from shipblock.io import check_plausible_samples, check_sampling_interval
 from shipblock.units import si_factor
 
-__all__ = ["COMPONENTS", "COMPONENT_KEY", "GroundMotion", "check_motion", "rotate_to_azimuth"]
+__all__ = ["COMPONENTS", "COMPONENT_KEY", "GroundMotion", "check_motion", "require_components",
+           "rotate_to_azimuth"]
 
 #: Component names, in order.
 COMPONENTS = ("H1", "H2", "V")
@@ -437,3 +438,49 @@ def check_motion(value, name: str = "motion") -> GroundMotion:
             f"{name} must be a shipblock.GroundMotion (from read_motion or "
             f"GroundMotion.from_arrays), got {type(value).__name__}")
     return value
+
+
+def require_components(motion: GroundMotion, components, *, record: str, key: str) -> None:
+    """Refuse a record that lacks components a study needs.
+
+    A pipeline whose vertical is scaled with the horizontal (``vertical = "same"``) needs a
+    vertical in every record: without one the runs would be horizontal-only, and only NaNs in
+    the results would show it.
+
+    Parameters
+    ----------
+    motion : GroundMotion
+        The record as read.
+    components : iterable of {"H1", "H2", "V"}
+        The components needed (``"H1"`` stands for any horizontal: a record has H1 or H2).
+    record : str
+        The record's id, for the message.
+    key : str
+        What needs them, as the user wrote it (``'vertical = "same"'``), for the message.
+
+    Raises
+    ------
+    RecordError
+        Naming the record, the missing components, what it holds, and ``key``.
+    ParameterError
+        If a component name is not one of :data:`COMPONENTS`.
+
+    Examples
+    --------
+    >>> require_components(motion, ("H1", "V"), record="Corralitos.0",
+    ...                    key='vertical = "same"')  # doctest: +SKIP
+    """
+    held = set(motion.components)
+    missing = []
+    for component in components:
+        checks.choice(component, "components", COMPONENTS)
+        if component == "H1" and held & {"H1", "H2"}:
+            continue
+        if component not in held:
+            missing.append(component)
+    if missing:
+        name = "a vertical (V)" if missing == ["V"] else "components " + ", ".join(missing)
+        raise RecordError(
+            record, f"has no {name}; it holds {', '.join(c for c in COMPONENTS if c in held)},"
+            f" but {key} needs it (leave the record out, or choose a study setting that does"
+            " not need it)")
