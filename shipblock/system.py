@@ -370,7 +370,7 @@ class ShipBlockSystem:
 
 
 def implausible(system: ShipBlockSystem) -> list[str]:
-    """What about a system is outside any dock, in words an engineer can check.
+    r"""What about a system is outside any dock, in words an engineer can check.
 
     Three quantities, each with its range (a unit mistake, tonnes given as kilograms, leaves at
     least one of them orders of magnitude out):

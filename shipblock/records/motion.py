@@ -479,7 +479,7 @@ def require_components(motion: GroundMotion, components, *, record: str, key: st
         if component not in held:
             missing.append(component)
     if missing:
-        name = "a vertical (V)" if missing == ["V"] else "components " + ", ".join(missing)
+        name = "vertical (V)" if missing == ["V"] else "component " + ", ".join(missing)
         raise RecordError(
             record, f"has no {name}; it holds {', '.join(c for c in COMPONENTS if c in held)},"
             f" but {key} needs it (leave the record out, or choose a study setting that does"
