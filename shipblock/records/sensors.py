@@ -21,7 +21,7 @@ from shipblock.checks import how_to_pass
 from shipblock.errors import ParameterError, RecordError
 from shipblock.records.motion import COMPONENT_KEY, COMPONENTS, ORIENTATION_TOLERANCE, trace_source
 
-__all__ = ["HORIZONTAL_RULE", "assign_components", "orientation_letter", "select_sensor", "sensor_code"]
+__all__ = ["HORIZONTAL_RULE", "assign_components", "describe_horizontal", "orientation_letter", "select_sensor", "sensor_code"]
 
 _TWO_LETTER = {"NS": "N", "EW": "E", "UD": "Z"}
 
@@ -258,3 +258,18 @@ def _order_horizontals(horizontals, info):
         if abs(separation - 270.0) <= ORIENTATION_TOLERANCE:
             return [horizontals[1], horizontals[0]]
     return list(horizontals)
+
+
+def describe_horizontal(motion) -> str:
+    """Which horizontal the solver uses for a GroundMotion, where it came from, and by which
+    rule (:data:`HORIZONTAL_RULE`), in words for ``shipblock info`` and ``simulate``."""
+    chosen = motion.metadata.get("horizontal", "H1")
+    if chosen not in ("H1", "H2"):
+        return f"{chosen} (--azimuth)"
+    channel = motion.metadata.get("channels", {}).get(chosen, "")
+    azimuth = motion.azimuths.get(chosen)
+    where = ", ".join(x for x in (channel.strip("."), "" if azimuth is None
+                                  else f"azimuth {azimuth:g} deg") if x)
+    how = ("chosen with --horizontal" if motion._horizontal is not None
+           else f"the default (--horizontal H2 or --azimuth DEG to change)\n  rule: {HORIZONTAL_RULE}")
+    return f"{chosen}{f' ({where})' if where else ''}, {how}"
