@@ -244,3 +244,34 @@ def test_require_components_names_record_and_key():
                        key='vertical = "same"')
     with pytest.raises(ParameterError, match="components"):
         require_components(loma, ("X",), record="Corralitos.0", key="k")
+
+
+# ------------------------------------------------------------------ every option in three places
+def _flags(parser, command):
+    sub = next(a for a in parser._actions if a.dest == "command").choices[command]
+    return {flag for action in sub._actions for flag in action.option_strings}
+
+
+def test_every_read_option_is_a_flag_of_each_record_command_and_a_catalogue_key():
+    import inspect
+
+    from shipblock.checks import READ_OPTIONS
+    from shipblock.cli import build_parser
+    from shipblock.records.catalogue import READ_KEYS
+
+    parser = build_parser()
+    keywords = set(inspect.signature(read_motion).parameters) - {"paths_or_stream",
+                                                                 "read_kwargs"}
+    keywords |= {"dt", "data_type", "resample_rate", "resample_interval"}  # reader keywords
+    assert keywords <= set(READ_OPTIONS)
+    for command in ("simulate", "info", "process", "catalogue"):
+        flags = _flags(parser, command)
+        for keyword, (flag, _) in READ_OPTIONS.items():
+            if command == "catalogue" and keyword in ("azimuth", "horizontal"):
+                continue  # a property of the dock, chosen when a record is used
+            assert flag in flags, (command, flag)
+    entry_keys = {key for _, key in READ_OPTIONS.values()}
+    assert set(READ_KEYS) <= entry_keys
+    # the catalogue entry's own fields carry the rest
+    assert entry_keys - set(READ_KEYS) == {"units", "inventory", "event", "components",
+                                           "horizontal", "azimuth"}

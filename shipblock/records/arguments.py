@@ -130,6 +130,11 @@ def add_read_arguments(g) -> None:
     g.add_argument("--data-type", choices=["acceleration"],
                    help="state what an SMC file whose header says '0 UNKNOWN' holds (only"
                         " acceleration, in the format's cm/s^2, can be read)")
+    g.add_argument("--resample-rate", type=float, metavar="HZ",
+                   help="rate onto which SMC/USC files of (time, value) pairs are interpolated"
+                        " [samples/s] (default 200)")
+    g.add_argument("--resample-interval", type=float, metavar="SECONDS",
+                   help="interval of a DMG file's resampling [s]")
 
 
 def _channel_map(items) -> dict | None:
@@ -151,7 +156,8 @@ def _channel_map(items) -> dict | None:
 _READ_OPTION_ARGS = {"inventory": "inventory", "units": "units", "response": "response",
                      "differentiate": "differentiate", "sensor": "sensor", "align": "align",
                      "gaps": "gaps", "event": "event", "format": "read_format", "dt": "dt",
-                     "data_type": "data_type"}
+                     "data_type": "data_type", "resample_rate": "resample_rate",
+                     "resample_interval": "resample_interval"}
 
 
 def read_options(args) -> dict:

@@ -395,8 +395,9 @@ class GroundMotion:
                 if az.get("H1") is None or az.get("H2") is None:
                     raise RecordError(
                         self._label, "azimuths of the horizontals are unknown; cannot rotate"
-                        " (give horizontal='H1'/'H2' instead, command line --horizontal H1, or an"
-                        " inventory with azimuths, --inventory FILE)"
+                        f" (use one as recorded: {checks.how_to_pass('horizontal', 'H1')}; or give"
+                        " an inventory with azimuths: "
+                        f"{checks.how_to_pass('inventory', 'FILE.xml', placeholder=True)})"
                     )
                 try:
                     return rotate_to_azimuth(comps["H1"], comps["H2"], az["H1"], az["H2"],
