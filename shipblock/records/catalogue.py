@@ -483,6 +483,8 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
             "duration_s": float(motion.dt * (motion.npts - 1)),
         }
         inventory = _inventory_file(motion, inventories) if md.get("inventory") else None
+        if inventory is None and isinstance(options.get("inventory"), str):
+            inventory = options["inventory"]  # given with --inventory
         if inventory is not None:
             table["inventory"] = _relative(inventory, base)
         if units:

@@ -204,6 +204,8 @@ def _label(key: tuple) -> str:
     network, station, location, sensor, fmt, volume = key
     if not (network or station):
         return station or location or "?"
+    if not (network or location or sensor) and Path(station).name != station:
+        return Path(station).name  # no codes: the key holds the file (_group_key)
     return f"{network}.{station}.{location}.{sensor}{volume and ' ' + volume}"
 
 
