@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 from collections.abc import Mapping
 
 import numpy as np
@@ -335,7 +336,9 @@ class GroundMotion:
 
     @property
     def name(self) -> str:
-        """Short name: the catalogue id, else NET.STA, else the name given to :meth:`from_arrays`."""
+        """Short name: the catalogue id, else NET.STA, else the name given to :meth:`from_arrays`,
+        else the first file's name (a file that states no codes, e.g. an SMC file of type
+        ``0 UNKNOWN``)."""
         md = self._metadata
         cat = md.get("catalogue") or {}
         if cat.get("id"):
@@ -343,6 +346,8 @@ class GroundMotion:
         st = md.get("station")
         if isinstance(st, dict) and (st.get("network") or st.get("station")):
             return ".".join(code for code in (st.get("network"), st.get("station")) if code)
+        if isinstance(st, dict) and md.get("source_files"):
+            return os.path.basename(str(md["source_files"][0]))
         return str(st or md.get("name") or "record")
 
     @property
