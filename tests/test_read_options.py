@@ -9,7 +9,6 @@ command-line flag, the catalogue key and the Python keyword that read it.
 
 from __future__ import annotations
 
-import logging
 from pathlib import Path
 
 import numpy as np

@@ -21,7 +21,8 @@ from shipblock.checks import how_to_pass
 from shipblock.errors import ParameterError, RecordError
 from shipblock.records.motion import COMPONENT_KEY, COMPONENTS, ORIENTATION_TOLERANCE, trace_source
 
-__all__ = ["HORIZONTAL_RULE", "assign_components", "describe_horizontal", "orientation_letter", "select_sensor", "sensor_code"]
+__all__ = ["HORIZONTAL_RULE", "assign_components", "describe_horizontal", "orientation_letter",
+           "select_sensor", "sensor_code"]
 
 _TWO_LETTER = {"NS": "N", "EW": "E", "UD": "Z"}
 
