@@ -56,6 +56,8 @@ def test_evt_refused_without_channel_map_names_the_flag_and_key(capsys):
     assert code == 2
     assert "--channel-map CHANNEL=H1" in err and "[record.components]" in err
     assert "channel_map=" in err
+    # channels "1" and "2" are channel numbers, not orientations: all three are named as unknown
+    assert all(f".MEMA..{n}" in err for n in "012")
 
 
 @needs_outside

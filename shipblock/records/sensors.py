@@ -27,6 +27,11 @@ __all__ = ["HORIZONTAL_RULE", "assign_components", "describe_horizontal", "orien
 _TWO_LETTER = {"NS": "N", "EW": "E", "UD": "Z"}
 
 
+#: Formats whose channel codes are channel numbers (``"0"``, ``"1"``, ...), not orientation
+#: codes: their components come from ``channel_map`` (or an inventory), never from the code.
+CHANNEL_NUMBER_FORMATS = {"KINEMETRICS_EVT"}
+
+
 def orientation_letter(channel: str) -> str:
     """The orientation letter of a channel code (``"HNZ"`` -> ``"Z"``, ``"UD"`` -> ``"Z"``)."""
     code = channel.strip().upper()
@@ -59,6 +64,8 @@ def _orientation(trace: Trace, inventory):
         if dip is None and found.get("dip") is not None:
             dip = float(found["dip"])
     letter = orientation_letter(stats.channel)
+    if stats.get("_format") in CHANNEL_NUMBER_FORMATS:
+        letter = ""  # "1", "2" are channel numbers there, not orientations: channel_map tells
     if dip is not None:
         if abs(abs(dip) - 90.0) <= ORIENTATION_TOLERANCE:
             return "V", None, float(math.copysign(90.0, dip)), note
