@@ -9,6 +9,7 @@ command-line flag, the catalogue key and the Python keyword that read it.
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -276,3 +277,15 @@ def test_every_read_option_is_a_flag_of_each_record_command_and_a_catalogue_key(
     # the catalogue entry's own fields carry the rest
     assert entry_keys - set(READ_KEYS) == {"units", "inventory", "event", "components",
                                            "horizontal", "azimuth"}
+
+
+@needs_outside
+def test_simulate_names_the_horizontal_and_takes_quantities(capsys, caplog):
+    with caplog.at_level(logging.WARNING, logger="shipblock.system"):
+        code, out, err = run(capsys, "simulate", str(V2), "--ship-mass", "20000 t",
+                             "--block-mass", "4 t", "--n-blocks", "100", "--half-width", "600mm",
+                             "--half-height", "0.75")
+    assert code == 0, err
+    assert "horizontal  H1 (CE.89486..HN1, azimuth 180 deg)" in out and "rule:" in out
+    assert "M = 2e+07 kg on 100 blocks of 4000 kg" in out
+    assert not [r for r in caplog.records if r.name == "shipblock.system"]
