@@ -146,13 +146,13 @@ def _channel_map(items) -> dict | None:
         for part in item.split(","):
             channel, sep, component = part.partition("=")
             if not sep or not channel.strip() or component.strip() not in ("H1", "H2", "V"):
-                raise ParameterError(f"--channel-map expects CHANNEL=H1, CHANNEL=H2 or CHANNEL=V"
-                                f" (comma-separated or repeated), got {part!r}")
+                raise ParameterError(f"--channel-map expects CHANNEL=H1, CHANNEL=H2 or"
+                                     f" CHANNEL=V (comma-separated or repeated), got {part!r}")
             mapping[channel.strip()] = component.strip()
     return mapping
 
 
-#: The read options of _add_conversion_arguments: read_motion keyword -> attribute of args.
+#: The flags of add_read_arguments: read_motion keyword -> attribute of the parsed arguments.
 _READ_OPTION_ARGS = {"inventory": "inventory", "units": "units", "response": "response",
                      "differentiate": "differentiate", "sensor": "sensor", "align": "align",
                      "gaps": "gaps", "event": "event", "format": "read_format", "dt": "dt",

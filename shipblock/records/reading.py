@@ -176,7 +176,10 @@ def read_motion(
         channel code (``"HN"``), optionally after the location (``"02.HN"``; K-NET/KiK-net:
         ``"01"`` is the borehole, ``"02"`` the surface sensor).
     **read_kwargs
-        Passed to the file reader (e.g. ``dt`` [s] for one-column text files).
+        Passed to the file reader: ``dt`` [s] for one-column text files, ``data_type``
+        (``"acceleration"``) for SMC files of type ``0 UNKNOWN``, ``resample_rate`` [Hz],
+        ``resample_interval`` [s] (:func:`shipblock.io.read_record`). Every option here is also
+        a command-line flag and a catalogue entry key (:data:`shipblock.checks.READ_OPTIONS`).
 
     Returns
     -------
