@@ -45,11 +45,13 @@ __all__ = [
     "MAX_TIME_STEP",
     "MIN_PERIOD",
     "MIN_TIME_STEP",
+    "READ_OPTIONS",
     "acceleration",
     "azimuth",
     "choice",
     "existing_file",
     "flag",
+    "how_to_pass",
     "is_real",
     "pathname",
     "real",
@@ -431,3 +433,65 @@ def unit(value, name: str, *, velocity: bool = True) -> str:
     if canonical_unit(value) is None and not (velocity and canonical_velocity_unit(value)):
         raise ParameterError(f"{name} must be {known}, got {value!r}")
     return value
+
+
+#: Every option of reading a record, by its Python keyword (of
+#: :func:`shipblock.read_motion` and the readers it passes ``**read_kwargs`` to): its
+#: command-line flag (``shipblock simulate/info/process/catalogue``) and its key in a
+#: catalogue entry (``[[record]]`` of a catalogue TOML, which pipelines read). Error messages
+#: that ask for an option name all three (:func:`how_to_pass`).
+READ_OPTIONS: dict[str, tuple[str, str]] = {
+    "units": ("--units", "units"),
+    "inventory": ("--inventory", "inventory"),
+    "response": ("--response", "response"),
+    "differentiate": ("--differentiate", "differentiate"),
+    "channel_map": ("--channel-map", "components"),
+    "sensor": ("--sensor", "sensor"),
+    "align": ("--align", "align"),
+    "gaps": ("--gaps", "gaps"),
+    "event": ("--event", "event"),
+    "format": ("--input-format", "format"),
+    "dt": ("--dt", "dt"),
+    "data_type": ("--data-type", "data_type"),
+    "resample_rate": ("--resample-rate", "resample_rate"),
+    "resample_interval": ("--resample-interval", "resample_interval"),
+    "horizontal": ("--horizontal", "horizontal"),
+    "azimuth": ("--azimuth", "azimuth"),
+}
+
+
+def how_to_pass(keyword: str, value, placeholder: bool = False) -> str:
+    """How to give a read option, in the three places it can be given.
+
+    Parameters
+    ----------
+    keyword : str
+        A key of :data:`READ_OPTIONS` (the Python keyword).
+    value : str, bool or float
+        The value to suggest (``True`` for a switch such as ``differentiate``).
+    placeholder : bool, optional
+        ``value`` is a name standing for the user's value (``"SECONDS"``), written bare.
+
+    Returns
+    -------
+    str
+        E.g. ``pass --align resample (catalogue key align = "resample"; Python
+        align='resample')``; for ``channel_map`` the catalogue's ``[record.components]`` table.
+
+    Examples
+    --------
+    >>> how_to_pass("dt", "SECONDS", placeholder=True)
+    'pass --dt SECONDS (catalogue key dt = SECONDS; Python dt=SECONDS)'
+    """
+    flag, key = READ_OPTIONS[keyword]
+    if keyword == "channel_map":
+        return (f"pass --channel-map CHANNEL=H1 (CHANNEL a channel code, SEED id or file name;"
+                f" one per channel, H1, H2 or V, comma-separated or repeated;"
+                f" catalogue table [record.components] with CHANNEL = \"H1\"; Python"
+                f" channel_map={{'CHANNEL': 'H1', ...}})")
+    if value is True:
+        return f"pass {flag} (catalogue key {key} = true; Python {keyword}=True)"
+    if placeholder:
+        return f"pass {flag} {value} (catalogue key {key} = {value}; Python {keyword}={value})"
+    toml = f'"{value}"' if isinstance(value, str) else f"{value!r}"
+    return f"pass {flag} {value} (catalogue key {key} = {toml}; Python {keyword}={value!r})"

@@ -22,11 +22,11 @@ from shipblock.units import STANDARD_GRAVITY
 log = logging.getLogger("shipblock")
 
 SYSTEM_FLAGS = {
-    "ship_mass": ("--ship-mass", float, "ship mass M [kg]"),
-    "block_mass": ("--block-mass", float, "mass of one keel block m [kg]"),
+    "ship_mass": ("--ship-mass", str, "ship mass M: kg, or with a unit: '20000 t'"),
+    "block_mass": ("--block-mass", str, "mass of one keel block m: kg, or with a unit: '4 t'"),
     "n_blocks": ("--n-blocks", int, "number of keel blocks n"),
-    "half_width": ("--half-width", float, "block half width B [m]"),
-    "half_height": ("--half-height", float, "block half height H [m]"),
+    "half_width": ("--half-width", str, "block half width B: m, or with a unit: 600mm"),
+    "half_height": ("--half-height", str, "block half height H: m, or with a unit: 750mm"),
     "mu_s_ground": ("--mu-s-ground", float, "static friction blocks/ground"),
     "mu_k_ground": ("--mu-k-ground", float, "kinetic friction blocks/ground"),
     "mu_s_ship": ("--mu-s-ship", float, "static friction blocks/ship"),
@@ -130,29 +130,26 @@ def _add_record_arguments(p):
     g.add_argument("--record", help="id of a catalogue record, e.g. NP.1765 or south-napa-2014/NP.1765")
     g.add_argument("--catalogue", help="record catalogue TOML (default: the shipped one)")
     _add_conversion_arguments(g)
-    g.add_argument("--sensor", help="sensor to use when a station has several: LOC.CODE, e.g."
-                                    " 02.HN (KiK-net surface) or HN")
     g.add_argument("--azimuth", type=float,
                    help="dock transverse axis [deg clockwise from north]: horizontals rotated to it")
-    g.add_argument("--horizontal", choices=["H1", "H2"], help="use this horizontal component")
+    g.add_argument("--horizontal", choices=["H1", "H2"],
+                   help="use this horizontal component (default H1, the record's first"
+                        " horizontal; see docs/user_guide/records.rst)")
     g.add_argument("--processing", default="default",
                    help="'default' (the documented chain), 'demean', 'none', or a TOML file with "
                         "[[processing]] steps")
 
 
 def _add_conversion_arguments(g):
-    g.add_argument("--inventory", help="StationXML for raw counts (and channel orientations)")
-    g.add_argument("--units", help="units of records that do not state them: m/s^2, cm/s^2, gal,"
-                                   " g, or velocity m/s, cm/s (with --differentiate)")
-    g.add_argument("--response", choices=["sensitivity", "full"], default="sensitivity",
-                   help="with --inventory: divide by the overall sensitivity (default) or remove"
-                        " the full instrument response")
-    g.add_argument("--differentiate", action="store_true",
-                   help="differentiate velocity records to acceleration (said in the provenance)")
+    from shipblock.records.arguments import add_read_arguments
+
+    add_read_arguments(g)
 
 
-def _conversion_kwargs(args) -> dict:
-    return {"response": args.response, "differentiate": args.differentiate}
+def _read_options(args) -> dict:
+    from shipblock.records.arguments import read_options
+
+    return read_options(args)
 
 
 def _find_entry(record_id, catalogue):
@@ -192,16 +189,28 @@ def _processing_chain(spec):
     return chain
 
 
-def _load_motion(args, process=True):
-    from shipblock.records.reading import read_motion
+def _load_motion(args):
+    """The record of the command line, processed as --processing says."""
+    return _processed(_read_record(args), args)
+
+
+def _processed(motion, args):
     from shipblock.processing import process_motion
+
+    chain = _processing_chain(args.processing)
+    return process_motion(motion, chain) if chain else motion
+
+
+def _read_record(args):
+    """The record of the command line as read (converted to m/s^2, not processed)."""
+    from shipblock.records.reading import read_motion
 
     if args.record and args.files:
         raise UserError("give either --record or record files, not both")
     if args.record:
         entry = _find_entry(args.record, args.catalogue)
         motion = entry.read(azimuth=args.azimuth, horizontal=args.horizontal,
-                            **_conversion_kwargs(args))
+                            **_read_options(args))
     elif args.files:
         import glob
 
@@ -209,24 +218,36 @@ def _load_motion(args, process=True):
             if not Path(f).exists() and not glob.has_magic(f):
                 raise UserError(f"{f}: no such file")
         motion = read_motion(args.files if len(args.files) > 1 else args.files[0],
-                             inventory=args.inventory, units=args.units, azimuth=args.azimuth,
-                             horizontal=args.horizontal, sensor=args.sensor,
-                             **_conversion_kwargs(args))
+                             azimuth=args.azimuth, horizontal=args.horizontal,
+                             **_read_options(args))
     else:
         raise UserError("no record: give record files or --record ID (see 'shipblock info --help')")
-    chain = _processing_chain(args.processing) if process else []
-    if chain:
-        motion = process_motion(motion, chain)
     return motion
+
+
+def _horizontal_line(motion) -> str:
+    from shipblock.records.sensors import describe_horizontal
+
+    return describe_horizontal(motion)
 
 
 # --------------------------------------------------------------------------- subcommands
 def _system_from_args(args):
-    from shipblock.system import ShipBlockSystem
+    """The system of --system and the system flags; quantities with units converted to SI
+    (shipblock.quantities), and a warning for a system outside any dock
+    (shipblock.system.warn_implausible)."""
+    from shipblock.quantities import to_si
+    from shipblock.system import FIELD_UNITS, ShipBlockSystem, warn_implausible
 
     system = ShipBlockSystem.from_toml(args.system) if args.system else ShipBlockSystem.example()
     changes = {k: getattr(args, k) for k in SYSTEM_FLAGS if getattr(args, k) is not None}
-    return system.replace(**changes) if changes else system
+    changes = {k: to_si(v, FIELD_UNITS[k], SYSTEM_FLAGS[k][0]) if k in FIELD_UNITS else v
+               for k, v in changes.items()}
+    if not changes:
+        return system
+    system = system.replace(**changes)
+    warn_implausible(system, "the command line's system")
+    return system
 
 
 def _scaled_input(args, motion):
@@ -262,6 +283,7 @@ def cmd_simulate(args):
     motion = _load_motion(args)
     ax, ay, scale = _scaled_input(args, motion)
     log.info("simulating %d samples at dt = %g s", ax.size, motion.dt)
+    sys.stdout.write(f"horizontal  {_horizontal_line(motion)}\n")
     res = simulate(system, ax, ay, motion.dt, rtol=args.rtol)
     name = motion.name
     record = record_text(motion, scale)
@@ -405,7 +427,8 @@ def cmd_info(args):
 
     from shipblock import intensity
 
-    motion = _load_motion(args)
+    raw = _read_record(args)
+    motion = _processed(raw, args)
     out = sys.stdout
     md = motion.metadata
     site = (md.get("catalogue") or {}).get("site", "")
@@ -421,47 +444,64 @@ def cmd_info(args):
             out.write(f"units {comp:<5} {note}\n")
     elif units:
         out.write(f"units       {units}\n")
-    out.write("component  azimuth   PGA [g]   PGV [cm/s]  Arias [m/s]  CAV [m/s]  D5-95 [s]\n")
+    processed = motion is not raw
+    stated = {tr.stats.get("motion_component"): tr.stats.get("stated_peak_si")
+              for tr in raw.stream}
+    out.write("PGA [g]: 'as read' is after unit conversion only"
+              + (", 'processed' after the processing below" if processed else "")
+              + ("; 'file states' is the peak the file's header states" if any(stated.values())
+                 else "") + "\n")
+    out.write("component  azimuth  as read" + ("  processed" if processed else "")
+              + ("  file states" if any(stated.values()) else "")
+              + f"  {'(processed) ' if processed else ''}PGV [cm/s]  Arias [m/s]  CAV [m/s]"
+                "  D5-95 [s]\n")
     for comp, acc in motion.components.items():
         im = intensity.intensity_measures(acc, motion.dt, periods=(0.2, 1.0))
         az = motion.azimuths.get(comp)
-        out.write(f"{comp:<10} {'' if az is None else f'{az:7.1f}':>7}  {im['pga'] / STANDARD_GRAVITY:8.4f}"
-                  f"  {100 * im['pgv']:10.3f}  {im['arias']:11.4f}  {im['cav']:9.4f}"
-                  f"  {im['d5_95']:9.2f}\n")
+        row = (f"{comp:<10} {'' if az is None else f'{az:7.1f}':>7}"
+               f"  {np.abs(raw.components[comp]).max() / STANDARD_GRAVITY:7.4f}")
+        if processed:
+            row += f"  {im['pga'] / STANDARD_GRAVITY:9.4f}"
+        if any(stated.values()):
+            peak = stated.get(comp)
+            row += f"  {'' if peak is None else f'{peak / STANDARD_GRAVITY:11.4f}':>11}"
+        out.write(row + f"  {100 * im['pgv']:10.3f}  {im['arias']:11.4f}  {im['cav']:9.4f}"
+                        f"  {im['d5_95']:9.2f}\n")
     h = motion.horizontal
     sa = intensity.spectral_acceleration(h, motion.dt, np.array([0.2, 1.0]), 0.05)
-    out.write(f"horizontal used by the solver: PGA {np.abs(h).max() / STANDARD_GRAVITY:.4f} g, "
-              f"Sa(0.2 s) {sa[0] / STANDARD_GRAVITY:.4f} g, Sa(1 s) {sa[1] / STANDARD_GRAVITY:.4f} g\n")
+    out.write(f"horizontal used by the solver: {_horizontal_line(motion)}\n")
+    out.write(f"  {'processed: ' if processed else ''}PGA {np.abs(h).max() / STANDARD_GRAVITY:.4f}"
+              f" g, Sa(0.2 s) {sa[0] / STANDARD_GRAVITY:.4f} g,"
+              f" Sa(1 s) {sa[1] / STANDARD_GRAVITY:.4f} g\n")
     for note in md.get("processing", []) or []:
         out.write(f"processing  {note}\n")
     if args.figure:
-        _record_figure(args, motion)
+        _record_figure(args, raw, motion)
         out.write(f"figure written to {args.figure}\n")
     return 0
 
 
-def _record_figure(args, processed):
+def _record_figure(args, raw, processed):
     """``info --figure``: the record as read and processed, spectra, Fourier amplitudes."""
     from shipblock.plot import plot_record_overview
 
-    raw = _load_motion(args, process=False)
     done = processed if processed.metadata.get("processing") else None
     _save_figure(lambda: plot_record_overview(raw, done)["spectra"].figure, args.figure)
 
 
 def cmd_catalogue(args):
-    from shipblock.records.catalogue import catalogue_toml, load_catalogue
+    from shipblock.records.catalogue import catalogue_toml, load_catalogue, record_id
     from shipblock.records.folders import read_motions
 
-    found = read_motions(args.sources, inventory=args.inventory, units=args.units,
-                         **_conversion_kwargs(args))
+    options = _read_options(args)
+    found = read_motions(args.sources, **options)
     for where, why in found.failures:
         log.warning("not used: %s: %s", where, why)
     if not found.motions:
         raise UserError(f"no record could be read from {', '.join(args.sources)}"
                         f" ({len(found.failures)} failures listed above)")
     text = catalogue_toml(found, args.output, licence=args.license, credit=args.credit,
-                          units=args.units)
+                          options=options)
     output = Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     partial = output.with_name(output.name + ".part")
@@ -477,7 +517,7 @@ def cmd_catalogue(args):
     for motion in found.motions:
         peaks = "  ".join(f"{c} {abs(a).max() / STANDARD_GRAVITY:.4f} g"
                           for c, a in motion.components.items())
-        sensor = next(iter(motion.metadata.get("channels", {}).values()), motion.name)[:-1]
+        sensor = record_id(motion)
         sys.stdout.write(f"  {sensor:<20} dt {motion.dt:g} s  {motion.npts:>7} samples  {peaks}\n")
     return 0
 
@@ -486,13 +526,14 @@ def cmd_process(args):
     import csv
 
     from shipblock import intensity
+    from shipblock.records.catalogue import record_file_stem
 
     motion = _load_motion(args)
     outdir = Path(args.output_dir)
     outdir.mkdir(parents=True, exist_ok=True)
     st = motion.stream.copy()
     name = motion.name
-    stem = name.replace("/", "_")
+    stem = record_file_stem(name)
     fmt = args.format.upper()
     ext = {"MSEED": "mseed", "SAC": "sac"}[fmt]
     written = []
@@ -746,7 +787,7 @@ def build_parser():
                        " that cannot be read are listed with their reasons.")
     s.add_argument("sources", nargs="+", help="folders, glob patterns or files")
     s.add_argument("--output", "-o", default="catalogue.toml", help="catalogue TOML to write")
-    g = s.add_argument_group("conversion")
+    g = s.add_argument_group("reading (stored in each entry, so that it reads back the same)")
     _add_conversion_arguments(g)
     s.add_argument("--license", "--licence", dest="license", help="licence of the records")
     s.add_argument("--credit", help="credit line of the records")

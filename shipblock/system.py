@@ -8,6 +8,7 @@ block-ship interface (:math:`\\mu_{s2}, \\mu_{k2}`).
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import asdict, dataclass
 from functools import cached_property
@@ -16,7 +17,10 @@ import numpy as np
 
 from shipblock.checks import choice, real, whole
 from shipblock.errors import ParameterError, ParameterTypeError
+from shipblock.quantities import to_si
 from shipblock.units import STANDARD_GRAVITY
+
+logger = logging.getLogger(__name__)
 
 IMPACT_RULES = ("momentum", "paper", "plastic")
 
@@ -55,6 +59,30 @@ FIELD_LIMITS: dict[str, tuple[float | None, float | None, str]] = {
     "block_inertia": (0.0, None, "kg m^2"),  # and MIN_INERTIA_RATIO .. 1 times m (B^2 + H^2)
     "g": (0.1, 100.0, "m/s^2"),
 }
+
+#: SI unit of each dimensional field in pint's spelling: a string value (``"20000 t"``,
+#: ``"600 mm"``) is converted to it (:func:`shipblock.quantities.to_si`).
+FIELD_UNITS: dict[str, str] = {
+    "ship_mass": "kg",
+    "block_mass": "kg",
+    "half_width": "m",
+    "half_height": "m",
+    "block_inertia": "kg * m**2",
+    "g": "m/s**2",
+}
+
+#: Plausibility of a dock (:func:`implausible`): a system outside these ranges runs, but with a
+#: warning, since it is most likely a unit mistake (tonnes given as kg). Density of a block taken
+#: :data:`ASSUMED_BLOCK_LENGTH` long along the keel [kg/m^3]: timber 500-900, concrete about
+#: 2400, steel 7850, and keel-block stacks of steel, concrete and timber between.
+BLOCK_DENSITY_RANGE = (300.0, 8000.0)
+#: The block length along the keel the density check assumes [m] (the 2-D model does not know
+#: it; keel blocks are 0.5 to 2 m long).
+ASSUMED_BLOCK_LENGTH = 1.0
+#: Ship weight per block, M g / n [N]: small craft on few blocks to the heaviest docked hulls.
+LOAD_PER_BLOCK_RANGE = (5e3, 4e6)
+#: Ship mass over the mass of all blocks, M / (n m) [-]: the ship outweighs its blocks.
+SHIP_TO_BLOCKS_RANGE = (1.0, 1e4)
 
 #: Smallest ratio I / (m R^2) of a block_inertia given explicitly [-] (1/3 for a uniform block).
 MIN_INERTIA_RATIO = 1e-6
@@ -286,7 +314,10 @@ class ShipBlockSystem:
         Parameters
         ----------
         values : Mapping
-            Constructor arguments; a nested ``system`` table is accepted too.
+            Constructor arguments; a nested ``system`` table is accepted too. A dimensional
+            field (:data:`FIELD_UNITS`) may be a string with a unit (``"20000 t"``), converted
+            to SI; numbers are SI. A system outside a dock's ranges is logged as a warning
+            (:func:`warn_implausible`).
         source : str
             Where the values came from, for error messages.
 
@@ -302,15 +333,18 @@ class ShipBlockSystem:
         if unknown:
             raise ParameterError(f"{source}: unknown system parameter(s) {unknown}; known: {sorted(known)}")
         try:
-            return cls(**values)
+            system = cls(**si_values(values))
         except ParameterError as exc:  # also a ParameterTypeError: keep the type
             raise type(exc)(f"{source}: {exc}") from None
         except TypeError as exc:  # a missing field
             raise ParameterTypeError(f"{source}: {exc}") from None
+        warn_implausible(system, source)
+        return system
 
     @classmethod
     def from_toml(cls, path) -> ShipBlockSystem:
-        """Read a system from a TOML file with a ``[system]`` table (SI units)."""
+        """Read a system from a TOML file with a ``[system]`` table: numbers in SI units, or
+        strings with a unit (``ship_mass = "20000 t"``, ``half_width = "600 mm"``)."""
         import tomllib
 
         try:
@@ -333,3 +367,93 @@ class ShipBlockSystem:
     def to_dict(self) -> dict:
         """The constructor arguments as a plain dict (for provenance and TOML)."""
         return asdict(self)
+
+
+def implausible(system: ShipBlockSystem) -> list[str]:
+    r"""What about a system is outside any dock, in words an engineer can check.
+
+    Three quantities, each with its range (a unit mistake, tonnes given as kilograms, leaves at
+    least one of them orders of magnitude out):
+
+    * the density of a block :data:`ASSUMED_BLOCK_LENGTH` (1 m) long along the keel,
+      :math:`\rho = m / (2B \cdot 2H \cdot L)`, within :data:`BLOCK_DENSITY_RANGE`;
+    * the ship's weight per block, :math:`Mg/n`, within :data:`LOAD_PER_BLOCK_RANGE`;
+    * the ship-to-blocks mass ratio :math:`M/(nm)`, within :data:`SHIP_TO_BLOCKS_RANGE`.
+
+    Parameters
+    ----------
+    system : ShipBlockSystem
+
+    Returns
+    -------
+    list of str
+        One sentence per quantity out of its range (empty for a plausible dock).
+    """
+    found = []
+    density = system.block_mass / (4.0 * system.half_width * system.half_height
+                                   * ASSUMED_BLOCK_LENGTH)
+    low, high = BLOCK_DENSITY_RANGE
+    if not low <= density <= high:
+        found.append(
+            f"block density {density:.3g} kg/m^3 (block mass {system.block_mass:.4g} kg in a"
+            f" {2 * system.half_width:g} m x {2 * system.half_height:g} m section, taken"
+            f" {ASSUMED_BLOCK_LENGTH:g} m long) is outside {low:g}-{high:g} kg/m^3 (timber to"
+            " steel): is block_mass in kg (--block-mass \"4 t\" for tonnes)?")
+    load = system.ship_mass * system.g / system.n_blocks
+    low, high = LOAD_PER_BLOCK_RANGE
+    if not low <= load <= high:
+        found.append(
+            f"ship weight per block {load / 1e3:.3g} kN (ship mass {system.ship_mass:.4g} kg on"
+            f" {system.n_blocks} blocks) is outside {low / 1e3:g}-{high / 1e3:g} kN: is"
+            " ship_mass in kg (--ship-mass \"20000 t\" for tonnes)?")
+    ratio = system.ship_mass / (system.n_blocks * system.block_mass)
+    low, high = SHIP_TO_BLOCKS_RANGE
+    if not low <= ratio <= high:
+        found.append(
+            f"ship-to-blocks mass ratio M/(n m) = {ratio:.3g} is outside {low:g}-{high:g}"
+            " (a docked ship outweighs its blocks, and blocks are not feathers)")
+    return found
+
+
+def warn_implausible(system: ShipBlockSystem, source: str = "system") -> list[str]:
+    """Log a warning (logger ``shipblock.system``) for each of :func:`implausible`'s findings.
+
+    Parameters
+    ----------
+    system : ShipBlockSystem
+    source : str, optional
+        Where the system came from (a file, the command line), for the message.
+
+    Returns
+    -------
+    list of str
+        The findings warned about.
+    """
+    found = implausible(system)
+    for finding in found:
+        logger.warning("%s: implausible for a ship on keel blocks: %s", source, finding)
+    return found
+
+
+def si_values(values) -> dict:
+    """A ``[system]`` table's values with the quantities given with a unit in SI.
+
+    Parameters
+    ----------
+    values : Mapping
+        Field name -> value; a dimensional field (:data:`FIELD_UNITS`) may be a string with a
+        unit (``"20000 t"``, ``"600 mm"``). Numbers (SI) and other fields pass unchanged.
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    ParameterError
+        Naming the key, for a string that is not a quantity of the field's dimension
+        (:func:`shipblock.quantities.to_si`).
+    """
+    return {key: (to_si(value, FIELD_UNITS[key], key)
+                  if key in FIELD_UNITS and isinstance(value, str) else value)
+            for key, value in values.items()}

@@ -52,6 +52,7 @@ from shipblock.io import screen
 from shipblock.io._common import (
     MAX_DIGITIZATION_GAP_S,
     PolarityReversalWarning,
+    UNITS_GIVEN_KEY,
     check_count_value,
     check_plausible_samples,
     check_sampling_interval,
@@ -67,6 +68,7 @@ __all__ = [
     "FORMATS",
     "MAX_DIGITIZATION_GAP_S",
     "PolarityReversalWarning",
+    "UNITS_GIVEN_KEY",
     "check_count_value",
     "check_format",
     "check_plausible_samples",
@@ -241,7 +243,8 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
         Acceleration unit of a plain text file (passed to the ``SHIPBLOCK_TEXT`` reader only);
         any unit :func:`shipblock.checks.unit` knows.
     **kwargs
-        Passed to the reader: ``dt`` [s] for a one-column text file, ``resample_rate`` [Hz] for
+        Passed to the reader: ``dt`` [s] for a one-column text file, ``data_type``
+        (``"acceleration"``) for an SMC file whose header says ``0 UNKNOWN``, ``resample_rate`` [Hz] for
         SMC and USC files, ``resample_interval`` [s] for DMG files (each checked: an interval
         within 1e-4..1 s, a rate within 1..1e4 Hz), or obspy's own keywords.
 
@@ -279,6 +282,8 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
     for key, check in _NUMERIC_KEYWORDS.items():
         if kwargs.get(key) is not None:
             kwargs[key] = check(kwargs[key], key)
+    if kwargs.get("data_type") is not None:
+        checks.choice(kwargs["data_type"], "data_type", smc.STATED_DATA_TYPES)
     if format == text.FORMAT:
         kwargs["units"] = units
     if format is None:

@@ -56,6 +56,11 @@ DEFAULT_RESAMPLE_RATE_HZ = 200.0
 #: the 1-25 Hz motion of the record, so a longer gap is taken for a corrupt time column.
 MAX_DIGITIZATION_GAP_S = 0.25
 
+#: Key of ``trace.stats`` a reader sets to ``True`` when the unit of the samples is the one the
+#: caller gave (``units=``, command line ``--units``) because the file states none, so that the
+#: provenance says "given with --units", not "from the file header".
+UNITS_GIVEN_KEY = "units_given"
+
 #: A floating-point number as written by Fortran or C (``1.0``, ``-.25E-03``, ``3``, ``1.2D+01``).
 FLOAT_RE = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?")
 

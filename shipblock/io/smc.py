@@ -63,7 +63,8 @@ import numpy as np
 from obspy import Stream, UTCDateTime
 from obspy.core import AttribDict
 
-from shipblock.errors import ParameterError, RecordError, UnitsError
+from shipblock.checks import how_to_pass
+from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     band_code,
     DEFAULT_RESAMPLE_RATE_HZ,
@@ -87,6 +88,9 @@ __all__ = ["FORMAT", "is_smc", "read_smc"]
 
 #: Name under which the reader is registered as an obspy waveform plug-in.
 FORMAT = "SHIPBLOCK_SMC"
+
+#: What a caller may state an SMC file of data type ``0 UNKNOWN`` holds (``data_type=``).
+STATED_DATA_TYPES = ("acceleration",)
 
 #: Unit of SMC accelerations (the format's own; the header states no unit code).
 SMC_UNIT = "cm/s^2"
@@ -268,7 +272,7 @@ def _site(ints, null) -> tuple[str, str]:
     return "structure", words
 
 
-def _orientation(ints, null, component_text, rate, name) -> dict:
+def _orientation(ints, null, component_text, rate, name, unknown_type=False) -> dict:
     """Channel code, azimuth and dip from the orientation fields (text ``component=`` if null)."""
     vertical, azimuth = ints[12], ints[13]
     token = component_text.strip().lower()
@@ -297,6 +301,10 @@ def _orientation(ints, null, component_text, rate, name) -> dict:
         return orientation_stats(
             rate, vertical=False, azimuth_deg=float(azimuth), index=horizontal_index(azimuth)
         )
+    if vertical == null and unknown_type:
+        # A "0 UNKNOWN" file (PEER's conversions) states nothing but its samples: the component
+        # is the caller's to give (channel_map, by file name).
+        return {}
     if vertical == null:
         # Nothing says vertical or horizontal (pyrotd's PEER copies): an unknown component that
         # read_motion refuses unless the caller names it (channel_map).
@@ -365,9 +373,9 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
         Sampling rate [samples/s] onto which an unevenly digitized record (time, value pairs) is
         linearly interpolated. Evenly sampled records are returned as stored.
     data_type : {"acceleration"}, optional
-        What a file whose line 1 is ``0 UNKNOWN`` holds, stated by the caller (pyrotd's test
-        files of PEER records are written so). Without it such a file is refused; a file that
-        states its own data type ignores it.
+        What the file holds when line 1 says ``0 UNKNOWN`` (PEER's ``.AT2.smc`` conversions are
+        written so): ``"acceleration"`` reads it as an accelerogram in the format's cm/s^2 (the
+        provenance says the type was stated by the caller). Ignored for files that state a type.
     **kwargs
         Ignored (obspy passes its own keywords to every plug-in).
 
@@ -403,12 +411,10 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
         raise UnitsError(name, f"holds {match.group(2).lower()}, not acceleration")
     if code in (5, 6):
         raise RecordError(name, f"holds {match.group(2).lower()}, not a time series")
-    if data_type not in (None, "acceleration"):
-        raise ParameterError(f"data_type must be None or 'acceleration', got {data_type!r}")
-    if code == 0 and data_type is None:
-        raise UnitsError(name, "data type is '0 UNKNOWN' (line 1): not known to be an"
-                               " acceleration; if it is one, say so with"
-                               " data_type='acceleration' (a read_record/read_motion keyword)")
+    if code == 0 and data_type != "acceleration":
+        raise UnitsError(name, "data type is '0 UNKNOWN'; not known to be an acceleration; if"
+                               " it is one (in cm/s^2, as SMC defines), "
+                               + how_to_pass("data_type", "acceleration"))
     ints = _ints(lines[_TEXT_LINES : _TEXT_LINES + _INT_LINES], name)
     reals = _reals(lines[_TEXT_LINES + _INT_LINES : _HEADER_LINES], name)
     inull, rnull = ints[0], reals[0]
@@ -460,8 +466,9 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
     peak_text = _PEAK_TEXT.search(text[6])
     header = AttribDict(
         {
-            "data_type": (match.group(2).upper() if code != 0
-                          else "UNKNOWN (acceleration as the caller states)"),
+            "data_type": match.group(2).upper(),
+            # "0 UNKNOWN" read as an accelerogram because the caller said so (data_type=)
+            "data_type_stated_by_caller": code == 0,
             "station_code": text[2][:5].strip(),
             "event": text[3].strip(),
             "station_name": text[5].split("component")[0].replace("station =", "").strip(" ,"),
@@ -494,14 +501,14 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
     floor = ints[24]
     stats = {
         "network": "US" if "USGS" in header["data_source"].upper() else "",
-        "station": text[2][:4].strip().strip("*"),  # "*": a line left blank
+        "station": text[2][:4].strip().strip("*"),  # "*": not stated
         "location": f"{floor:02d}" if ints[18] == 1 and floor != inull and 0 <= floor < 100
         else "",
         "units": "m/s**2",
         "original_units": SMC_UNIT,
         "sensor_site": site,
         "shipblock_smc": header,
-        **_orientation(ints, inull, component_text, sampling_rate, name),
+        **_orientation(ints, inull, component_text, sampling_rate, name, unknown_type=code == 0),
     }
     peaks = [abs(reals[i]) for i in (29, 31) if not _null(reals[i], rnull)]
     if peaks:

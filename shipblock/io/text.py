@@ -33,8 +33,10 @@ import numpy as np
 from obspy import Stream, UTCDateTime
 from obspy.core import AttribDict
 
+from shipblock.checks import how_to_pass
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
+    UNITS_GIVEN_KEY,
     check_plausible_samples,
     check_samples,
     check_sampling_interval,
@@ -236,9 +238,9 @@ def _resolve_units(stated: str | None, found: list[tuple[str, str]], name: str):
     if stated is None and not found:
         raise UnitsError(
             name,
-            "units unknown: a plain text record needs units= (for example 'g', 'm/s^2',"
-            " 'cm/s^2', 'gal'; command line: --units) or a header such as"
-            " '# time (s), accel (g)'",
+            "units unknown: a plain text record needs a header such as '# time (s), accel (g)'"
+            " or " + how_to_pass("units", "UNIT", placeholder=True) + ", UNIT for example g,"
+            " m/s^2, cm/s^2, gal (or m/s, cm/s for velocity, with --differentiate)",
         )
     if stated is not None:
         given = _unit_kind(stated)
@@ -281,7 +283,9 @@ def read_text_record(
         Read only the header (the samples are parsed anyway to know their number).
     units : str, optional
         Unit of the acceleration column (``"g"``, ``"m/s^2"``, ``"cm/s^2"``, ``"gal"``, ...);
-        required unless the header states it.
+        required unless the header states it. A velocity unit (``"m/s"``, ``"cm/s"``) reads a
+        velocity record: the trace is then in m/s (``stats.units == "m/s"``), to be
+        differentiated (``read_motion(..., differentiate=True)``).
     dt : float, optional
         Sampling interval [s]; required for one-column files without a ``dt =`` header line;
         checked against the time column of two-column files.
@@ -348,7 +352,8 @@ def read_text_record(
                                     " the blank lines if none is")
         delta = dt if dt is not None else _header_dt(header)
         if delta is None:
-            raise RecordError(name, "one-column record: the sampling interval is unknown; pass dt=")
+            raise RecordError(name, "one-column record: the sampling interval is unknown; "
+                                    + how_to_pass("dt", "SECONDS", placeholder=True))
     delta = check_sampling_interval(delta, name)
     start = UTCDateTime(starttime) if starttime is not None else UTCDateTime(0) + t0
     traces = []
@@ -364,6 +369,8 @@ def read_text_record(
                 {"header_lines": header, "columns": ncol, "units": unit, "units_stated_by":
                  "caller" if units is not None else "header", "notes": notes}
             ),
+            # the caller's unit is the samples' unit: the file states none, or contradicts itself
+            UNITS_GIVEN_KEY: units is not None and (not statements or bool(notes)),
             **component,
         }
         values = table[:, column if components else -1]
@@ -427,6 +434,6 @@ def _check_quantity_words(header, statements, units, name) -> list[str]:
         raise UnitsError(name, f"the header calls the samples {word} but states the"
                                f" {'/'.join(sorted(stated_kinds))} unit"
                                f" {', '.join(u for u, _ in statements)}: contradictory; state the"
-                               " unit with units= (command line: --units)")
+                               " unit: " + how_to_pass("units", "UNIT", placeholder=True))
     return [f"the header calls the samples {word} but states"
             f" {', '.join(u for u, _ in statements)}; units={units!r} given by the caller used"]

@@ -25,7 +25,13 @@ from __future__ import annotations
 
 from shipblock.records.catalogue import load_catalogue
 from shipblock.records.folders import MotionSet, read_motions
-from shipblock.records.motion import COMPONENT_KEY, COMPONENTS, GroundMotion, rotate_to_azimuth
+from shipblock.records.motion import (
+    COMPONENT_KEY,
+    COMPONENTS,
+    GroundMotion,
+    require_components,
+    rotate_to_azimuth,
+)
 from shipblock.records.reading import read_motion
 
 __all__ = [
@@ -36,5 +42,6 @@ __all__ = [
     "load_catalogue",
     "read_motion",
     "read_motions",
+    "require_components",
     "rotate_to_azimuth",
 ]

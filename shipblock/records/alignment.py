@@ -13,6 +13,7 @@ import math
 import numpy as np
 from obspy import Stream, Trace
 
+from shipblock.checks import how_to_pass
 from shipblock.errors import ParameterError, RecordError
 from shipblock.io import MAX_DIGITIZATION_GAP_S
 from shipblock.records.motion import COMPONENT_KEY, trace_source
@@ -107,6 +108,15 @@ def _check_overlap(first: Trace, second: Trace, name: str, seed_id: str) -> None
     )
 
 
+def _channel_key(trace: Trace):
+    """What makes traces pieces of one channel: the SEED id, and for a trace with neither station
+    nor channel code (a file that names nothing, e.g. an SMC file of type ``0 UNKNOWN``) also
+    its file: such files are components told apart by file name (``channel_map``)."""
+    if trace.stats.station.strip("*") or trace.stats.channel:
+        return trace.id
+    return trace.id, trace_source(trace)
+
+
 def merge_gaps(stream: Stream, gaps: str) -> Stream:
     """Merge traces of the same channel; refuse or fill gaps.
 
@@ -117,8 +127,9 @@ def merge_gaps(stream: Stream, gaps: str) -> Stream:
     if gaps not in ("refuse", "interpolate"):
         raise ParameterError(f"gaps must be 'refuse' or 'interpolate', not {gaps!r}")
     merged = Stream()
-    for seed_id in dict.fromkeys(tr.id for tr in stream):
-        group = Stream([tr for tr in stream if tr.id == seed_id])
+    for key in dict.fromkeys(_channel_key(tr) for tr in stream):
+        group = Stream([tr for tr in stream if _channel_key(tr) == key])
+        seed_id = group[0].id
         if len(group) == 1:
             merged += group
             continue
@@ -139,8 +150,8 @@ def merge_gaps(stream: Stream, gaps: str) -> Stream:
                      + (f", the longest {_seconds(longest)}" if len(gap_list) > 1 else ""))
             if gaps == "refuse":
                 raise RecordError(
-                    name, f"channel {seed_id} has {where}; pass gaps='interpolate' to fill gaps"
-                    f" of up to {MAX_INTERPOLATED_GAP_S:g} s",
+                    name, f"channel {seed_id} has {where}; {how_to_pass('gaps', 'interpolate')} to"
+                    f" fill gaps of up to {MAX_INTERPOLATED_GAP_S:g} s",
                 )
             if longest > MAX_INTERPOLATED_GAP_S:
                 raise RecordError(
@@ -189,7 +200,7 @@ def align_components(traces: list[Trace], align: str, notes: list[str]) -> None:
             raise RecordError(
                 label,
                 f"components have different sampling rates ({_describe(traces, origin)});"
-                " pass align='resample' to resample them to the lowest rate"
+                f" {how_to_pass('align', 'resample')} to resample them to the lowest rate"
                 f" ({rates[0]:g} Hz) after an anti-alias low-pass",
             )
         target = rates[0]

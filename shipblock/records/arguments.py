@@ -17,7 +17,8 @@ from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.io import check_format
 from shipblock.records.motion import COMPONENTS
 
-__all__ = ["ALIGNS", "GAPS", "RESPONSES", "check_channel_map", "check_read_arguments"]
+__all__ = ["ALIGNS", "GAPS", "RESPONSES", "add_read_arguments", "check_channel_map",
+           "check_read_arguments", "read_options"]
 
 #: Choices of read_motion's options.
 RESPONSES = ("sensitivity", "full")
@@ -93,3 +94,84 @@ def check_channel_map(channel_map):
                                      f" names (str), got {type(key).__name__} {key!r}")
         checks.choice(value, f"channel_map[{key!r}]", COMPONENTS)
     return dict(channel_map)
+
+
+# ----------------------------------------------------------------- the command line
+def add_read_arguments(g) -> None:
+    """Add the read options of :func:`shipblock.read_motion` to an argparse group, one flag
+    each (:data:`shipblock.checks.READ_OPTIONS` names them, and the catalogue key of each);
+    the ``shipblock`` command's ``simulate``, ``info``, ``process`` and ``catalogue`` share
+    them."""
+    g.add_argument("--inventory", help="StationXML for raw counts (and channel orientations)")
+    g.add_argument("--units", help="units of records that do not state them: m/s^2, cm/s^2, gal,"
+                                   " g, or velocity m/s, cm/s (with --differentiate)")
+    g.add_argument("--response", choices=["sensitivity", "full"],
+                   help="with --inventory: divide by the overall sensitivity (default) or remove"
+                        " the full instrument response")
+    g.add_argument("--differentiate", action="store_true", default=None,
+                   help="differentiate velocity records to acceleration (said in the provenance)")
+    g.add_argument("--channel-map", action="append", metavar="CHANNEL=COMPONENT",
+                   help="component of a channel the file does not name (channel code, SEED id or"
+                        " file name = H1, H2 or V), e.g. --channel-map 0=H1 --channel-map 3=H2"
+                        " or --channel-map 0=H1,3=H2,4=V (Kinemetrics EVT); unmapped channels"
+                        " are left out")
+    g.add_argument("--sensor", help="sensor to use when a station has several: LOC.CODE, e.g."
+                                    " 02.HN (KiK-net surface) or HN")
+    g.add_argument("--align", choices=["trim", "resample", "strict"],
+                   help="components of different windows or sampling rates: trim to the common"
+                        " window (default), resample to the lowest rate, or refuse (strict)")
+    g.add_argument("--gaps", choices=["refuse", "interpolate"],
+                   help="gaps inside a channel: refuse (default) or fill short ones linearly")
+    g.add_argument("--event", metavar="QUAKEML", help="the earthquake (QuakeML file)")
+    g.add_argument("--input-format", dest="read_format", metavar="FORMAT",
+                   help="obspy format name of the files (default: detected), e.g. SHIPBLOCK_TEXT")
+    g.add_argument("--dt", type=float, metavar="SECONDS",
+                   help="sampling interval of one-column text records [s]")
+    g.add_argument("--data-type", choices=["acceleration"],
+                   help="state what an SMC file whose header says '0 UNKNOWN' holds (only"
+                        " acceleration, in the format's cm/s^2, can be read)")
+    g.add_argument("--resample-rate", type=float, metavar="HZ",
+                   help="rate onto which SMC/USC files of (time, value) pairs are interpolated"
+                        " [samples/s] (default 200)")
+    g.add_argument("--resample-interval", type=float, metavar="SECONDS",
+                   help="interval of a DMG file's resampling [s]")
+
+
+def _channel_map(items) -> dict | None:
+    """``["0=H1,3=H2", "4=V"]`` -> ``{"0": "H1", "3": "H2", "4": "V"}`` (``--channel-map``)."""
+    if not items:
+        return None
+    mapping = {}
+    for item in items:
+        for part in item.split(","):
+            channel, sep, component = part.partition("=")
+            if not sep or not channel.strip() or component.strip() not in ("H1", "H2", "V"):
+                raise ParameterError(f"--channel-map expects CHANNEL=H1, CHANNEL=H2 or"
+                                     f" CHANNEL=V (comma-separated or repeated), got {part!r}")
+            mapping[channel.strip()] = component.strip()
+    return mapping
+
+
+#: The flags of add_read_arguments: read_motion keyword -> attribute of the parsed arguments.
+_READ_OPTION_ARGS = {"inventory": "inventory", "units": "units", "response": "response",
+                     "differentiate": "differentiate", "sensor": "sensor", "align": "align",
+                     "gaps": "gaps", "event": "event", "format": "read_format", "dt": "dt",
+                     "data_type": "data_type", "resample_rate": "resample_rate",
+                     "resample_interval": "resample_interval"}
+
+
+def read_options(args) -> dict:
+    """The read options given on the command line, as :func:`shipblock.read_motion` keywords
+    (only those given: the others keep the library's defaults, or a catalogue entry's keys).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``--channel-map``, for a mapping that is not ``CHANNEL=H1|H2|V``.
+    """
+    options = {key: getattr(args, attr) for key, attr in _READ_OPTION_ARGS.items()
+               if getattr(args, attr, None) is not None}
+    channel_map = _channel_map(getattr(args, "channel_map", None))
+    if channel_map:
+        options["channel_map"] = channel_map
+    return options

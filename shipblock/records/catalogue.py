@@ -9,6 +9,7 @@ codes to the components H1, H2 and V. Paths are relative to the catalogue file.
 
 from __future__ import annotations
 
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,18 +18,26 @@ import numpy as np
 
 from shipblock import checks
 from shipblock.errors import ParameterError, ParameterTypeError, RecordError
+from shipblock.records.arguments import check_read_arguments
 from shipblock.records.folders import MotionSet
 from shipblock.records.motion import COMPONENTS, GroundMotion
 from shipblock.records.reading import read_motion
 from shipblock.units import STANDARD_GRAVITY
 
-__all__ = ["CatalogueEntry", "catalogue_toml", "default_catalogue_path", "load_catalogue", "relative_path",
-           "toml_value"]
+__all__ = ["READ_KEYS", "CatalogueEntry", "catalogue_toml", "default_catalogue_path",
+           "load_catalogue", "record_file_stem", "record_id", "relative_path", "toml_value"]
 
 #: Catalogue layout version this module reads.
 SCHEMA_VERSION = 1
 
 _REQUIRED = ("id", "files", "station")
+
+#: Keys of a catalogue entry that are options of reading it (read_motion's keywords of the same
+#: name; ``components`` is its channel_map, ``units``, ``inventory`` and ``event`` are entry
+#: fields). What they accept is what read_motion and the command-line flags accept
+#: (:data:`shipblock.checks.READ_OPTIONS`).
+READ_KEYS = ("response", "differentiate", "align", "gaps", "format", "sensor", "dt", "data_type",
+             "resample_rate", "resample_interval")
 
 
 def default_catalogue_path() -> Path:
@@ -66,6 +75,10 @@ class CatalogueEntry:
         Channel code (or file name) -> ``"H1"``, ``"H2"`` or ``"V"``.
     units : str or None
         Unit to state for files that carry none (``None`` when the files or the inventory tell).
+    options : dict
+        The entry's read options (keys of :data:`READ_KEYS`: ``align = "resample"``,
+        ``dt = 0.01``, ``data_type = "acceleration"``, ...), passed to
+        :func:`shipblock.read_motion`.
     extra : dict
         Every other key of the table (event name, coordinates, source, ...).
     """
@@ -81,6 +94,7 @@ class CatalogueEntry:
     credit: str
     components: dict = field(default_factory=dict)
     units: str | None = None
+    options: dict = field(default_factory=dict)
     extra: dict = field(default_factory=dict)
 
     def read(self, azimuth: float | None = None, horizontal: str | None = None,
@@ -94,7 +108,8 @@ class CatalogueEntry:
         horizontal : {"H1", "H2"}, optional
             Use one horizontal as-is.
         **kwargs
-            Passed to :func:`shipblock.read_motion` (e.g. ``response="full"``).
+            Passed to :func:`shipblock.read_motion` (e.g. ``response="full"``); they take the
+            place of the entry's own read options (:attr:`options`) of the same name.
 
         Returns
         -------
@@ -121,7 +136,7 @@ class CatalogueEntry:
             horizontal=horizontal,
             channel_map=self.components or None,
             event=None if self.event is None else str(self.event),
-            **kwargs,
+            **{**self.options, **kwargs},
         )
         gm.metadata["catalogue"] = {
             "id": self.id, "site": self.site, "license": self.license, "credit": self.credit,
@@ -175,8 +190,9 @@ def _entry(table: dict, base: Path, catalogue: Path) -> CatalogueEntry:
             checks.unit(units, "units")
         except ParameterError as exc:
             raise RecordError(catalogue, f"record {entry_id!r}: {exc}") from None
+    options = _read_options(table, catalogue, entry_id)
     known = {"id", "files", "inventory", "event", "network", "station", "site", "license",
-             "credit", "components", "units"}
+             "credit", "components", "units", *READ_KEYS}
     return CatalogueEntry(
         id=str(entry_id),
         files=tuple(_path(base, f, catalogue, entry_id, "file") for f in files),
@@ -191,8 +207,36 @@ def _entry(table: dict, base: Path, catalogue: Path) -> CatalogueEntry:
         credit=str(table.get("credit", "")),
         components=dict(components),
         units=units,
+        options=options,
         extra={k: v for k, v in table.items() if k not in known},
     )
+
+
+def _read_options(table: dict, catalogue: Path, entry_id) -> dict:
+    """The read options of a catalogue entry (:data:`READ_KEYS`), checked as read_motion
+    checks them; a wrong one is an error naming the catalogue, the record and the key."""
+    options = {key: table[key] for key in READ_KEYS if key in table}
+    try:
+        checked = check_read_arguments(**{k: v for k, v in options.items()
+                                          if k in ("response", "differentiate", "align", "gaps",
+                                                   "format")})
+        if "format" in options:
+            options["format"] = checked["format"]
+        if "sensor" in options:
+            checks.text(options["sensor"], "sensor", what="a sensor code such as 'HN' or '02.HN'")
+        for key in ("dt", "resample_interval"):
+            if key in options:
+                options[key] = checks.time_step(options[key], key)
+        if "resample_rate" in options:
+            options["resample_rate"] = checks.real(
+                options["resample_rate"], "resample_rate", low=1.0 / checks.MAX_TIME_STEP,
+                high=1.0 / checks.MIN_TIME_STEP, units="Hz")
+        if "data_type" in options:
+            checks.choice(options["data_type"], "data_type", ("acceleration",))
+    except ParameterError as exc:
+        raise RecordError(catalogue, f"record {entry_id!r}: {exc} (a key of the [[record]]"
+                                     " table)") from None
+    return options
 
 
 def load_catalogue(path=None) -> dict[str, CatalogueEntry]:
@@ -302,8 +346,64 @@ def _inventory_file(motion, inventories: dict) -> Path | None:
     return None
 
 
+def _id_part(text: str) -> str:
+    """A piece of a record id: runs of anything but letters, digits, ``_`` and ``-`` become one
+    ``-`` (``"Anaheim - Lakeview & Riverdale"`` -> ``"Anaheim-Lakeview-Riverdale"``)."""
+    return re.sub(r"[^A-Za-z0-9_]+", "-", text).strip("-")
+
+
+def record_id(motion: GroundMotion) -> str:
+    """The catalogue id of a record: ``NET.STA.LOC.SENSOR`` (SEED codes, e.g. ``NP.1765..HN``).
+
+    A record without a network code (PEER AT2, Kinemetrics EVT, SMC) is named by its station and
+    its channels instead, each cleaned by :func:`_id_part`: ``Corralitos.0`` (Loma Prieta,
+    ``RSN753_LOMAP_CLS000.AT2``), ``Anaheim-Lakeview-Riverdale.360-90``. Ids never start with a
+    dot or hold spaces, so that file names made of them are neither hidden nor quoted.
+
+    Parameters
+    ----------
+    motion : GroundMotion
+
+    Returns
+    -------
+    str
+    """
+    station = motion.metadata.get("station") or {}
+    first = motion.stream[0]
+    channel = first.stats.channel
+    seed = len(channel) == 3 and channel[:2].isalpha()
+    if station.get("network") and seed:
+        return ".".join([station.get("network", ""), station.get("station", ""),
+                         station.get("location", ""), channel[:2]])
+    channels = "-".join(_id_part(tr.stats.channel) for tr in motion.stream if tr.stats.channel)
+    parts = [_id_part(station.get(key, "")) for key in ("network", "station", "location")]
+    parts.append(_id_part(channel[:2]) if seed else channels)
+    parts = [part for part in parts if part]
+    if not parts:  # nothing names it: its first file
+        parts = [_id_part(Path(motion.metadata.get("source_files", ["record"])[0]).stem)]
+    return ".".join(parts)
+
+
+def record_file_stem(record: str) -> str:
+    """A file name stem made of a record id: ``/`` and anything but letters, digits, ``.``, ``_``
+    and ``-`` become ``_``, and no leading dot (no hidden files).
+
+    Parameters
+    ----------
+    record : str
+        A record id (``"south-napa-2014/NP.1765..HN"``).
+
+    Returns
+    -------
+    str
+        E.g. ``"south-napa-2014_NP.1765..HN"``.
+    """
+    stem = re.sub(r"[^A-Za-z0-9._-]+", "_", str(record)).lstrip(".")
+    return stem or "record"
+
+
 def catalogue_toml(motions, output, licence: str | None = None, credit: str | None = None,
-                   units: str | None = None) -> str:
+                   units: str | None = None, options: dict | None = None) -> str:
     """The text of a record catalogue for the records of a :class:`~shipblock.records.folders.MotionSet`.
 
     Each record becomes a ``[[record]]`` table that :func:`load_catalogue` reads back: id
@@ -324,6 +424,11 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
         Terms of use and credit line of the records.
     units : str, optional
         The ``units=`` the records were read with (stored so that they read back the same).
+    options : dict, optional
+        The read options the records were read with (:func:`read_motions`' keywords: ``units``,
+        ``event``, ``align``, ``dt``, ...), stored in each entry so that it reads back the same
+        (``channel_map`` is stored as each entry's components, ``inventory`` as the StationXML
+        file that holds the station).
 
     Returns
     -------
@@ -343,6 +448,8 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
     output = checks.pathname(output, "output", "the catalogue file to write")
     licence = checks.text(licence, "licence", optional=True)
     credit = checks.text(credit, "credit", optional=True)
+    options = dict(options or {})
+    units = options.pop("units", units)
     if units is not None:
         checks.unit(units, "units")
     base = Path(output).resolve().parent
@@ -360,13 +467,12 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
         md = motion.metadata
         station = md.get("station") or {}
         first = motion.stream[0]
-        record_id = ".".join([station.get("network", ""), station.get("station", ""),
-                              station.get("location", ""), first.stats.channel[:2]])
-        seen[record_id] = seen.get(record_id, 0) + 1
-        if seen[record_id] > 1:
-            record_id += f"-{seen[record_id]}"
+        name = record_id(motion)
+        seen[name] = seen.get(name, 0) + 1
+        if seen[name] > 1:
+            name += f"-{seen[name]}"
         table = {
-            "id": record_id,
+            "id": name,
             "files": [relative_path(f, base) for f in md.get("source_files", [])],
             "network": station.get("network", ""),
             "station": station.get("station", ""),
@@ -378,10 +484,17 @@ def catalogue_toml(motions, output, licence: str | None = None, credit: str | No
             "duration_s": float(motion.dt * (motion.npts - 1)),
         }
         inventory = _inventory_file(motion, inventories) if md.get("inventory") else None
+        if inventory is None and isinstance(options.get("inventory"), str):
+            inventory = options["inventory"]  # given with --inventory
         if inventory is not None:
             table["inventory"] = relative_path(inventory, base)
         if units:
             table["units"] = units
+        if options.get("event") is not None and isinstance(options["event"], str):
+            table["event"] = relative_path(options["event"], base)
+        for key in READ_KEYS:
+            if options.get(key) is not None:
+                table[key] = options[key]
         event = md.get("event") or {}
         if event.get("id") or event.get("name"):
             table["event_name"] = str(event.get("id") or event.get("name"))

@@ -36,10 +36,10 @@ from obspy import Stream
 from shipblock import checks
 from shipblock.errors import ParameterError, RecordError, ShipblockError
 from shipblock.io import read_record
-from shipblock.records.arguments import check_read_arguments
+from shipblock.records.arguments import check_channel_map, check_read_arguments
 from shipblock.records.assembly import assemble_motion, load_stream
 from shipblock.records.motion import GroundMotion
-from shipblock.records.sensors import sensor_code
+from shipblock.records.sensors import select_sensor, sensor_code
 
 __all__ = ["MotionSet", "expand_sources", "read_motions"]
 
@@ -207,12 +207,16 @@ def _label(key: tuple) -> str:
     network, station, location, sensor, fmt, volume = key
     if not (network or station):
         return station or location or "?"
+    if not (network or location or sensor) and Path(station).name != station:
+        return Path(station).name  # no codes: the key holds the file (_group_key)
     return f"{network}.{station}.{location}.{sensor}{volume and ' ' + volume}"
 
 
 def read_motions(source, inventory=None, units: str | None = None, *,
                  response: str = "sensitivity", differentiate: bool = False,
-                 align: str = "trim", gaps: str = "refuse", event=None) -> MotionSet:
+                 align: str = "trim", gaps: str = "refuse", event=None,
+                 channel_map=None, sensor: str | None = None,
+                 format: str | None = None, **read_kwargs) -> MotionSet:  # noqa: A002
     """Read a folder, glob or list of record files into one ground motion per station sensor.
 
     Parameters
@@ -227,6 +231,17 @@ def read_motions(source, inventory=None, units: str | None = None, *,
         As in :func:`~shipblock.records.reading.read_motion`.
     event : optional
         QuakeML file or object; default: a QuakeML file among the sources, if there is one.
+    channel_map : dict, optional
+        As in :func:`~shipblock.records.reading.read_motion`, applied to every record (e.g. the
+        channels ``"0"``, ``"3"``, ``"4"`` of Kinemetrics EVT files).
+    sensor : str, optional
+        Keep only the records of this sensor (``"HN"``, ``"02.HN"``); the others are left out
+        (listed in ``skipped``).
+    format : str, optional
+        obspy format name of every file (auto-detected when omitted).
+    **read_kwargs
+        Passed to every file's reader (:func:`shipblock.io.read_record`): ``dt`` [s] of
+        one-column text files, ``data_type`` of SMC files, ``resample_rate``, ...
 
     Returns
     -------
@@ -246,9 +261,13 @@ def read_motions(source, inventory=None, units: str | None = None, *,
     """
     options = check_read_arguments(inventory=inventory, units=units, response=response,
                                    differentiate=differentiate, align=align, gaps=gaps,
-                                   event=event)
+                                   event=event, format=format)
     inventory, event, differentiate = (options["inventory"], options["event"],
                                        options["differentiate"])
+    format = options["format"]  # noqa: A001 - obspy's name for it
+    channel_map = check_channel_map(channel_map)
+    sensor = checks.text(sensor, "sensor", optional=True,
+                         what="a sensor code such as 'HN' or '02.HN'")
     result = MotionSet()
     paths = expand_sources(source)
     inventories, events, waveforms = [], [], []
@@ -280,7 +299,7 @@ def read_motions(source, inventory=None, units: str | None = None, *,
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                stream = read_record(path, units=units)
+                stream = read_record(path, format=format, units=units, **read_kwargs)
         except ShipblockError as exc:
             result.failures.append((str(path), getattr(exc, "problem", str(exc))))
             continue
@@ -288,13 +307,17 @@ def read_motions(source, inventory=None, units: str | None = None, *,
             groups.setdefault(_group_key(trace), Stream()).append(trace)
 
     for key, stream in _split_groups(groups):
+        if sensor is not None and not len(select_sensor(stream, sensor, None, strict=False)):
+            result.skipped.extend(dict.fromkeys(str(tr.stats.get("source_file", ""))
+                                                for tr in stream))
+            continue
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 motion = assemble_motion(
                     load_stream(stream, units, None, {}), inventory=inventory, units=units,
                     response=response, differentiate=differentiate, align=align, gaps=gaps,
-                    event=event,
+                    event=event, channel_map=channel_map, sensor=sensor,
                 )
         except ShipblockError as exc:
             files = ", ".join(dict.fromkeys(str(tr.stats.get("source_file", "")) for tr in stream))

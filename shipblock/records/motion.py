@@ -4,7 +4,8 @@
 whose traces are tagged with :data:`COMPONENT_KEY`) and the provenance of every conversion in
 ``metadata``; :func:`read_motion` (:mod:`shipblock.records.reading`) builds one from files,
 :meth:`GroundMotion.from_arrays` from arrays. Component conventions: H1 and H2 are the
-horizontals (``H2`` normally 90 deg clockwise from ``H1``), V the vertical, positive up. Azimuths
+horizontals (H1 the record's first, which the solver uses by default:
+:data:`shipblock.records.sensors.HORIZONTAL_RULE`), V the vertical, positive up. Azimuths
 are in degrees clockwise from north.
 """
 
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 from collections.abc import Mapping
 
 import numpy as np
@@ -22,7 +24,8 @@ from shipblock.errors import ParameterError, ParameterTypeError, RecordError, Un
 from shipblock.io import check_plausible_samples, check_sampling_interval
 from shipblock.units import si_factor
 
-__all__ = ["COMPONENTS", "COMPONENT_KEY", "GroundMotion", "check_motion", "rotate_to_azimuth"]
+__all__ = ["COMPONENTS", "COMPONENT_KEY", "GroundMotion", "check_motion", "require_components",
+           "rotate_to_azimuth"]
 
 #: Component names, in order.
 COMPONENTS = ("H1", "H2", "V")
@@ -333,7 +336,9 @@ class GroundMotion:
 
     @property
     def name(self) -> str:
-        """Short name: the catalogue id, else NET.STA, else the name given to :meth:`from_arrays`."""
+        """Short name: the catalogue id, else NET.STA, else the name given to :meth:`from_arrays`,
+        else the first file's name (a file that states no codes, e.g. an SMC file of type
+        ``0 UNKNOWN``)."""
         md = self._metadata
         cat = md.get("catalogue") or {}
         if cat.get("id"):
@@ -341,6 +346,8 @@ class GroundMotion:
         st = md.get("station")
         if isinstance(st, dict) and (st.get("network") or st.get("station")):
             return ".".join(code for code in (st.get("network"), st.get("station")) if code)
+        if isinstance(st, dict) and md.get("source_files"):
+            return os.path.basename(str(md["source_files"][0]))
         return str(st or md.get("name") or "record")
 
     @property
@@ -393,8 +400,9 @@ class GroundMotion:
                 if az.get("H1") is None or az.get("H2") is None:
                     raise RecordError(
                         self._label, "azimuths of the horizontals are unknown; cannot rotate"
-                        " (give horizontal='H1'/'H2' instead, command line --horizontal H1, or an"
-                        " inventory with azimuths, --inventory FILE)"
+                        f" (use one as recorded: {checks.how_to_pass('horizontal', 'H1')}; or give"
+                        " an inventory with azimuths: "
+                        f"{checks.how_to_pass('inventory', 'FILE.xml', placeholder=True)})"
                     )
                 try:
                     return rotate_to_azimuth(comps["H1"], comps["H2"], az["H1"], az["H2"],
@@ -436,3 +444,49 @@ def check_motion(value, name: str = "motion") -> GroundMotion:
             f"{name} must be a shipblock.GroundMotion (from read_motion or "
             f"GroundMotion.from_arrays), got {type(value).__name__}")
     return value
+
+
+def require_components(motion: GroundMotion, components, *, record: str, key: str) -> None:
+    """Refuse a record that lacks components a study needs.
+
+    A pipeline whose vertical is scaled with the horizontal (``vertical = "same"``) needs a
+    vertical in every record: without one the runs would be horizontal-only, and only NaNs in
+    the results would show it.
+
+    Parameters
+    ----------
+    motion : GroundMotion
+        The record as read.
+    components : iterable of {"H1", "H2", "V"}
+        The components needed (``"H1"`` stands for any horizontal: a record has H1 or H2).
+    record : str
+        The record's id, for the message.
+    key : str
+        What needs them, as the user wrote it (``'vertical = "same"'``), for the message.
+
+    Raises
+    ------
+    RecordError
+        Naming the record, the missing components, what it holds, and ``key``.
+    ParameterError
+        If a component name is not one of :data:`COMPONENTS`.
+
+    Examples
+    --------
+    >>> require_components(motion, ("H1", "V"), record="Corralitos.0",
+    ...                    key='vertical = "same"')  # doctest: +SKIP
+    """
+    held = set(motion.components)
+    missing = []
+    for component in components:
+        checks.choice(component, "components", COMPONENTS)
+        if component == "H1" and held & {"H1", "H2"}:
+            continue
+        if component not in held:
+            missing.append(component)
+    if missing:
+        name = "vertical (V)" if missing == ["V"] else "component " + ", ".join(missing)
+        raise RecordError(
+            record, f"has no {name}; it holds {', '.join(c for c in COMPONENTS if c in held)},"
+            f" but {key} needs it (leave the record out, or choose a study setting that does"
+            " not need it)")

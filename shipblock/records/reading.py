@@ -16,9 +16,10 @@ sampling rate, and returns a :class:`GroundMotion`. All conversions are recorded
   SAC files are multiplied by their ``scale`` header (``stats.calib``) first;
 * a trace whose unit stays unknown raises :class:`~shipblock.errors.UnitsError` naming the file.
 
-Component conventions: H1 and H2 are the horizontals (``H2`` normally 90 deg clockwise from
-``H1``), V the vertical, positive up (a vertical recorded positive down is flipped). Azimuths are
-in degrees clockwise from north.
+Component conventions: H1 and H2 are the horizontals (H1 the record's first, used by the solver
+unless ``horizontal=`` or ``azimuth=`` says otherwise:
+:data:`~shipblock.records.sensors.HORIZONTAL_RULE`), V the vertical, positive up (a vertical
+recorded positive down is flipped). Azimuths are in degrees clockwise from north.
 """
 
 from __future__ import annotations
@@ -75,10 +76,12 @@ def _names_many(source) -> bool:
 
 
 def _one_of_folder(source, inventory, units, response, differentiate, align, gaps, event,
-                   azimuth, horizontal, sensor) -> GroundMotion:
+                   azimuth, horizontal, sensor, channel_map, format,  # noqa: A002
+                   read_kwargs) -> GroundMotion:
     """The single record (of ``sensor``, if given) of a folder or glob; refuse several."""
     found = read_motions(source, inventory=inventory, units=units, response=response,
-                         differentiate=differentiate, align=align, gaps=gaps, event=event)
+                         differentiate=differentiate, align=align, gaps=gaps, event=event,
+                         channel_map=channel_map, format=format, **read_kwargs)
     motions = found.motions
     if sensor is not None:
         motions = [m for m in motions if len(select_sensor(m.stream, sensor, None, strict=False))]
@@ -96,7 +99,7 @@ def _one_of_folder(source, inventory, units, response, differentiate, align, gap
             label,
             f"holds {len(motions)} records ("
             + ", ".join(next(iter(m.metadata["channels"].values()))[:-1] for m in motions)
-            + "); choose one with sensor= (command line: --sensor) or name its files;"
+            + "); choose one: " + checks.how_to_pass("sensor", "HN") + ", or name its files;"
             " read_motions() (command line: shipblock catalogue) reads them all" + failures,
         )
     motion = motions[0]
@@ -173,7 +176,10 @@ def read_motion(
         channel code (``"HN"``), optionally after the location (``"02.HN"``; K-NET/KiK-net:
         ``"01"`` is the borehole, ``"02"`` the surface sensor).
     **read_kwargs
-        Passed to the file reader (e.g. ``dt`` [s] for one-column text files).
+        Passed to the file reader: ``dt`` [s] for one-column text files, ``data_type``
+        (``"acceleration"``) for SMC files of type ``0 UNKNOWN``, ``resample_rate`` [Hz],
+        ``resample_interval`` [s] (:func:`shipblock.io.read_record`). Every option here is also
+        a command-line flag and a catalogue entry key (:data:`shipblock.checks.READ_OPTIONS`).
 
     Returns
     -------
@@ -212,7 +218,8 @@ def read_motion(
     paths_or_stream = _check_sources(paths_or_stream)
     if _names_many(paths_or_stream):
         return _one_of_folder(paths_or_stream, inventory, units, response, differentiate, align,
-                              gaps, event, azimuth, horizontal, sensor)
+                              gaps, event, azimuth, horizontal, sensor, channel_map, format,
+                              read_kwargs)
     stream = load_stream(paths_or_stream, units, format, read_kwargs)
     return assemble_motion(stream, inventory=inventory, units=units, response=response,
                            differentiate=differentiate, align=align, gaps=gaps, event=event,

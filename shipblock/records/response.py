@@ -18,8 +18,9 @@ import warnings
 import numpy as np
 from obspy import Trace
 
+from shipblock.checks import how_to_pass
 from shipblock.errors import ParameterError, RecordError, UnitsError
-from shipblock.io import check_count_value, sensitivity_sign
+from shipblock.io import UNITS_GIVEN_KEY, check_count_value, sensitivity_sign
 from shipblock.records.motion import SI_UNITS, trace_source
 from shipblock.records.sensors import orientation_letter
 from shipblock.units import (
@@ -84,8 +85,8 @@ def _differentiate(trace: Trace, how: str, differentiate: bool, name: str, what:
     if not differentiate:
         raise UnitsError(
             name,
-            f"channel {trace.id} is a velocity record ({what}); pass differentiate=True"
-            " (command line: --differentiate) to differentiate it to acceleration",
+            f"channel {trace.id} is a velocity record ({what});"
+            f" {how_to_pass('differentiate', True)} to differentiate it to acceleration",
         )
     # Central differences inside, one-sided at the ends (obspy's Trace.differentiate).
     trace.data = np.gradient(np.asarray(trace.data, dtype=np.float64), trace.stats.delta)
@@ -111,8 +112,8 @@ def _by_sensitivity(trace, response, source_label, differentiate, name, note="")
     if quantity is None:
         raise UnitsError(
             name, f"{source_label}: channel {trace.id} senses {input_units or 'unknown units'},"
-            " which is neither an acceleration nor a velocity; use response='full'"
-            " (command line: --response full)",
+            " which is neither an acceleration nor a velocity; "
+            + how_to_pass("response", "full"),
         )
     trace.data = np.asarray(trace.data, dtype=np.float64) * (factor / value)
     how = (f"counts -> {'m/s**2' if quantity == 'acceleration' else 'm/s'} by the overall"
@@ -178,7 +179,7 @@ def _check_gravity(trace: Trace, unit: str, origin: str, name: str) -> None:
             name,
             f"{origin} says the samples are in nm/s^2, but vertical channel {trace.id} averages"
             f" {mean:.4g}: that is gravity in g, not 1 nm/s^2 (Community Seismic Network files"
-            " are written so); give units='g' (command line: --units g)",
+            " are written so); " + how_to_pass("units", "g"),
         )
 
 
@@ -193,14 +194,21 @@ def to_si(trace: Trace, inventory, inventory_name, units, response, differentiat
         key = canonical_unit(str(original))
         if units is not None and (key is None or si_factor(units, name)
                                   != ACCELERATION_UNITS_TO_SI[key]):
-            raise UnitsError(name, f"units={units!r} contradicts the file's own unit {original!r}")
+            raise UnitsError(name, f"units={units!r} contradicts the file's own unit {original!r}"
+                                   " (leave out --units, catalogue key units)")
+        if stats.get(UNITS_GIVEN_KEY):
+            return f"{original} -> m/s**2 as given with --units (units={units!r})"
+        if (stats.get("shipblock_smc") or {}).get("data_type_stated_by_caller"):
+            return (f"{original} -> m/s**2 (SMC's unit); the file's data type '0 UNKNOWN' taken"
+                    " for acceleration as stated with --data-type (data_type='acceleration')")
         return f"{original} -> m/s**2 from the file header ({fmt or 'stream'})"
-    given_by_reader = (units is not None and current == "m/s" and canonical_velocity_unit(units)
-                       == canonical_velocity_unit(str(stats.get("original_units", ""))))
-    if current == "m/s" and (units is None or given_by_reader):
-        # A text reader already applied the caller's velocity unit (units='cm/s').
-        origin = "the caller's units=" if given_by_reader else f"the file header ({fmt})"
-        how = f"{stats.get('original_units', 'm/s')} -> m/s from {origin}"
+    if current == "m/s" and (units is None or stats.get(UNITS_GIVEN_KEY)):
+        original = stats.get("original_units", "m/s")
+        if units is not None and canonical_velocity_unit(units) != canonical_velocity_unit(original):
+            raise UnitsError(name, f"units={units!r} contradicts the file's own unit {original!r}"
+                                   " (leave out --units, catalogue key units)")
+        how = (f"{original} -> m/s as given with --units (units={units!r})"
+               if stats.get(UNITS_GIVEN_KEY) else f"{original} -> m/s from the file header ({fmt})")
         how = _differentiate(trace, how, differentiate, name, "the file states velocity")
         stats.units = SI_UNITS
         return how
@@ -216,12 +224,14 @@ def to_si(trace: Trace, inventory, inventory_name, units, response, differentiat
         original = "counts"
     elif has_response and inventory is not None and units is not None:
         raise UnitsError(
-            name, "both an inventory and units= were given for raw data; give one of them"
+            name, "both an inventory (--inventory) and units= (--units) were given for raw data;"
+            " give one of them"
         )
     elif fmt in CALIB_IN_SI_FORMATS:
         if units is not None:
             raise UnitsError(
-                name, f"{fmt} records carry their own calibration; do not give units="
+                name, f"{fmt} records carry their own calibration; do not give units= (--units,"
+                " catalogue key units)"
             )
         check_count_value(stats.calib, name, f"the {CALIB_IN_SI_FORMATS[fmt]} (calibration"
                                              f" {stats.calib!r} m/s^2 per count)")
@@ -239,10 +249,10 @@ def to_si(trace: Trace, inventory, inventory_name, units, response, differentiat
             raise UnitsError(
                 name,
                 f"units of channel {trace.id} are unknown ({fmt or 'stream'} data"
-                f"{', raw counts' if current == 'counts' else ''}): give inventory= (StationXML;"
-                " command line: --inventory FILE) for raw counts, or units= ('m/s^2', 'cm/s^2',"
-                " 'gal', 'g', or a velocity unit 'm/s', 'cm/s' with differentiate=True; command"
-                " line: --units)",
+                f"{', raw counts' if current == 'counts' else ''}): for raw counts"
+                f" {how_to_pass('inventory', 'STATIONXML', placeholder=True)}; otherwise state"
+                f" the unit: {how_to_pass('units', 'UNIT', placeholder=True)}, UNIT one of"
+                " m/s^2, cm/s^2, gal, g, or a velocity unit m/s, cm/s with --differentiate",
             )
         data = np.asarray(trace.data, dtype=np.float64)
         prefix = ""

@@ -17,12 +17,19 @@ from collections.abc import Mapping
 import numpy as np
 from obspy import Stream, Trace
 
+from shipblock.checks import how_to_pass
 from shipblock.errors import ParameterError, RecordError
 from shipblock.records.motion import COMPONENT_KEY, COMPONENTS, ORIENTATION_TOLERANCE, trace_source
 
-__all__ = ["assign_components", "orientation_letter", "select_sensor", "sensor_code"]
+__all__ = ["HORIZONTAL_RULE", "assign_components", "describe_horizontal", "orientation_letter",
+           "select_sensor", "sensor_code"]
 
 _TWO_LETTER = {"NS": "N", "EW": "E", "UD": "Z"}
+
+
+#: Formats whose channel codes are channel numbers (``"0"``, ``"1"``, ...), not orientation
+#: codes: their components come from ``channel_map`` (or an inventory), never from the code.
+CHANNEL_NUMBER_FORMATS = {"KINEMETRICS_EVT"}
 
 
 def orientation_letter(channel: str) -> str:
@@ -57,6 +64,8 @@ def _orientation(trace: Trace, inventory):
         if dip is None and found.get("dip") is not None:
             dip = float(found["dip"])
     letter = orientation_letter(stats.channel)
+    if stats.get("_format") in CHANNEL_NUMBER_FORMATS:
+        letter = ""  # "1", "2" are channel numbers there, not orientations: channel_map tells
     if dip is not None:
         if abs(abs(dip) - 90.0) <= ORIENTATION_TOLERANCE:
             return "V", None, float(math.copysign(90.0, dip)), note
@@ -108,7 +117,7 @@ def select_sensor(stream: Stream, sensor: str | None, channel_map, strict: bool 
             "the files hold several sensors of one station: "
             + ", ".join(f"{code} ({', '.join(tr.stats.channel for tr in stream if sensor_code(tr) == code)})"
                         for code in sensors)
-            + "; choose one with sensor='<location>.<code>' (command line: --sensor)",
+            + "; choose one: " + how_to_pass("sensor", next(iter(sensors)).lstrip(".")),
         )
     wanted = sensor.strip().upper()
     chosen = Stream([tr for tr in stream if sensor_code(tr).upper() == wanted
@@ -168,7 +177,7 @@ def assign_components(
                 label,
                 "traces of several stations/locations: "
                 + ", ".join(".".join(s) for s in sorted(stations))
-                + "; pass channel_map= to choose",
+                + f"; {how_to_pass('channel_map', None)}",
             )
         verticals = [tr for tr in stream if info[id(tr)][0] == "V"]
         horizontals = [tr for tr in stream if info[id(tr)][0] == "H"]
@@ -186,12 +195,14 @@ def assign_components(
                     label,
                     "cannot tell the component of "
                     + ", ".join(f"{tr.id} ({trace_source(tr)})" for tr in unknown)
-                    + "; pass channel_map={'<channel or file>': 'H1'|'H2'|'V'}",
+                    + f"; {how_to_pass('channel_map', None)}",
                 )
         if len(verticals) > 1:
-            raise RecordError(label, f"{len(verticals)} vertical channels; pass channel_map=")
+            raise RecordError(label, f"{len(verticals)} vertical channels;"
+                                    f" {how_to_pass('channel_map', None)}")
         if len(horizontals) > 2:
-            raise RecordError(label, f"{len(horizontals)} horizontal channels; pass channel_map=")
+            raise RecordError(label, f"{len(horizontals)} horizontal channels;"
+                                    f" {how_to_pass('channel_map', None)}")
         if len(horizontals) == 2:
             horizontals = _order_horizontals(horizontals, info)
         for component, trace in zip(("H1", "H2"), horizontals, strict=False):
@@ -230,16 +241,45 @@ def assign_components(
     return assigned
 
 
+#: How H1 and H2 are told apart when the channels are not mapped (``channel_map``); the solver
+#: uses H1 unless told otherwise (``horizontal=``, ``azimuth=``). Printed by ``shipblock info``
+#: and ``simulate`` and documented in docs/user_guide/records.rst.
+HORIZONTAL_RULE = (
+    "H1 is the record's first horizontal: N before E and 1 before 2 by the channel codes'"
+    " last letters; otherwise the first in the file (a file holding all components, e.g. a"
+    " CSMIP V2), or, for one file per component, the one the other is 90 deg clockwise from"
+    " (PEER 000/090: 000), else the first file given"
+)
+
+
 def _order_horizontals(horizontals, info):
+    """H1 first (:data:`HORIZONTAL_RULE`)."""
     letters = [orientation_letter(tr.stats.channel) for tr in horizontals]
     for first, second in (("N", "E"), ("1", "2")):
         if set(letters) == {first, second}:
             return sorted(
                 horizontals, key=lambda tr: orientation_letter(tr.stats.channel) != first
             )
+    if trace_source(horizontals[0]) == trace_source(horizontals[1]):
+        return list(horizontals)  # one file: its order
     az = [info[id(tr)][1] for tr in horizontals]
     if None not in az:
         separation = (az[1] - az[0]) % 360.0
         if abs(separation - 270.0) <= ORIENTATION_TOLERANCE:
             return [horizontals[1], horizontals[0]]
     return list(horizontals)
+
+
+def describe_horizontal(motion) -> str:
+    """Which horizontal the solver uses for a GroundMotion, where it came from, and by which
+    rule (:data:`HORIZONTAL_RULE`), in words for ``shipblock info`` and ``simulate``."""
+    chosen = motion.metadata.get("horizontal", "H1")
+    if chosen not in ("H1", "H2"):
+        return f"{chosen} (--azimuth)"
+    channel = motion.metadata.get("channels", {}).get(chosen, "")
+    azimuth = motion.azimuths.get(chosen)
+    where = ", ".join(x for x in (channel.strip("."), "" if azimuth is None
+                                  else f"azimuth {azimuth:g} deg") if x)
+    how = ("chosen with --horizontal" if motion._horizontal is not None
+           else f"the default (--horizontal H2 or --azimuth DEG to change)\n  rule: {HORIZONTAL_RULE}")
+    return f"{chosen}{f' ({where})' if where else ''}, {how}"
