@@ -388,8 +388,10 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     while t < t_end:
         # steps end on the input samples (the input is linear between them)
         t_next = (math.floor(t / dt_rec + 1e-9) + 1.0) * dt_rec
+        if t_end - t < 1e-12 * dt_rec:
+            break
         h = min(h, h_max, t_next - t, t_end - t)
-        if h < 1e-14:
+        if h < 1e-15 * max(1.0, t):
             failure = EV_STALL
             break
         for m in range(nx):
@@ -499,7 +501,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
         _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n)
         if first >= 0:
             kind, index = _transition(first, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg,
-                                      dp, dc0, tc0, fs, delta, tang, acc)
+                                      dp, dc0, tc0, fs, delta, normal, tang, acc)
             if n_ev < ev_t.shape[0]:
                 ev_t[n_ev] = t
                 ev_kind[n_ev] = kind
@@ -540,7 +542,7 @@ def _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n):
 
 @njit(cache=True)
 def _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, delta,
-                tang, acc):
+                normal, tang, acc):
     """Apply event ``q`` at time t (state x just past it); returns (event kind, index)."""
     o_u = 6 * nb
     if q < 2 * nsp:
@@ -590,8 +592,13 @@ def _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, 
             fs[j] = 1 if tang[j] < 0.0 else -1
             x[o_u + j] = 0.0
             return EV_SLIP, j
+        # stick again with the spring preloaded to the kinetic friction force, so that the force is
+        # continuous; its energy is booked against the friction loss (it is given back at the next
+        # slip onset, or stays stored)
+        u = fs[j] * strip_f[j, SF_MUK] * normal[j] / strip_f[j, SF_KT]
+        acc[A_FRIC_EVENT] -= 0.5 * strip_f[j, SF_KT] * u * u
         fs[j] = F_STICK
-        x[o_u + j] = 0.0
+        x[o_u + j] = u
         return EV_STICK, j
     o = 2 * nsp + ns
     if q < o + nb - 1:

@@ -373,6 +373,22 @@ def static_state(asm: Assembly) -> InitialState:
             f"the section has no static solution under gravity (largest unbalanced force "
             f"{worst:.2e} of the weight): the ship is not stable on its supports at rest; add side "
             "lines, widen the keel block or lower Ship.g_height")
+    # the static state must be stable: the tangent stiffness (finite differences of the
+    # generalised forces, the stick springs following the displacement) positive definite
+    n_free = int(free.sum())
+    stiff = np.zeros((n_free, n_free))
+    step = 1e-7
+    for m in range(n_free):
+        dz = np.zeros(n_free)
+        dz[m] = step / scale_q
+        stiff[:, m] = -(residual(sol.x + dz) - residual(sol.x - dz)) * scale_f / (2 * step)
+    stiff = 0.5 * (stiff + stiff.T)
+    lowest = np.linalg.eigvalsh(stiff)[0]
+    if lowest <= 0.0:
+        raise ParameterError(
+            f"the section's static state is unstable (tangent stiffness {lowest:.3g} < 0 in its "
+            "softest direction): the ship would tip off its supports at rest; add side lines, "
+            "widen the keel block or lower Ship.g_height")
     over = fn > asm.spring_f[:, K.PF_FY]
     if np.any(over):
         j = int(np.searchsorted(asm.strip_i[:, K.SI_FIRST], np.argmax(over), side="right") - 1)

@@ -78,6 +78,10 @@ class SectionResult:
         Terms of the energy balance at the end [J] and its relative residual.
     stats : dict
         Accepted and rejected steps, events.
+    plastic_set : ndarray
+        Permanent set of every spring at the end [m] (strips in :attr:`strip_names` order, the
+        section's ``n_springs`` springs each).
+    strip_names : list of str
     """
 
     time: np.ndarray
@@ -92,6 +96,8 @@ class SectionResult:
     summary: dict
     energy: dict
     stats: dict
+    plastic_set: np.ndarray
+    strip_names: list
     section: DockSection = field(repr=False)
 
     def to_dataset(self):
@@ -182,7 +188,8 @@ def energy_terms(asm: Assembly, x, reg, dp, dc0, tc0, fs, t) -> dict:
 def simulate_section(section: DockSection, motion, vertical=None, dt: float | None = None, *,
                      rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
                      separation_height: float = DEFAULT_SEPARATION_HEIGHT,
-                     max_events: int = DEFAULT_MAX_EVENTS) -> SectionResult:
+                     max_events: int = DEFAULT_MAX_EVENTS,
+                     initial_velocity=None) -> SectionResult:
     """Simulate a dock section under a horizontal (across the dock) and vertical ground motion.
 
     The run starts from the elastic static state (:func:`shipblock.section.model.static_state`)
@@ -210,6 +217,9 @@ def simulate_section(section: DockSection, motion, vertical=None, dt: float | No
         lift-off (milliseconds after a rocking impact) is reported, not a failure.
     max_events : int
         Most located events before the run stops as ``"stalled"``.
+    initial_velocity : array_like, optional
+        Velocities ``(v_y, v_z, omega)`` of every body (the ship, then the moving lines) added to
+        the static state at t = 0 [m/s, rad/s], shape (n_bodies, 3); within 10 m/s and 10 rad/s.
 
     Returns
     -------
@@ -248,6 +258,15 @@ def simulate_section(section: DockSection, motion, vertical=None, dt: float | No
     dc0 = np.zeros(nsp)
     tc0 = np.zeros(nsp)
     fs = init.friction.copy()
+    if initial_velocity is not None:
+        v0 = checks.as_real_array(initial_velocity, "initial_velocity", "an array of velocities")
+        if v0.shape != (nb, 3) or not np.all(np.abs(v0) <= 10.0):
+            raise ParameterError(f"initial_velocity must have shape ({nb}, 3) (the ship, then the "
+                                 f"moving lines) with entries within 10 m/s or rad/s, got "
+                                 f"shape {v0.shape}")
+        x[3 * nb:6 * nb] += v0.ravel()
+        if section.roll_held:
+            x[3 * nb + 2] = 0.0
     e0 = energy_terms(asm, x, reg, dp, dc0, tc0, fs, 0.0)
     n = ah.size
     t_end = (n - 1) * dt
@@ -359,7 +378,8 @@ def _result(section, asm, init, hx, hn, ht, dt, t_final, ev_t, ev_kind, ev_index
         events.append(SectionEvent(float(tt), kind, where))
     del nb
     return SectionResult(time, ship, lines, normal, friction, sway, events, fail,
-                         summary["failure_time"], summary, energy, stats, section)
+                         summary["failure_time"], summary, energy, stats, dp.copy(), names,
+                         section)
 
 
 def simulate_section_batch(section: DockSection, motions, **options) -> list[dict]:
