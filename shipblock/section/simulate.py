@@ -290,13 +290,19 @@ def simulate_section(section: DockSection, motion, vertical=None, dt: float | No
         "damping": float(d_damp + acc[K.A_CAP_RELAX]),
         "friction": float(d_fric + acc[K.A_FRIC_EVENT]),
         "crushing": e1["crushing"],
-        "kinetic": e1["kinetic"], "potential_change": e1["potential"] - e0["potential"],
+        "kinetic_change": e1["kinetic"] - e0["kinetic"],
+        # from the height changes (not a difference of two large energies)
+        "potential_change": float(np.sum(asm.mass * section.g * (x[1:3 * nb:3]
+                                                                 - init.x[1:3 * nb:3]))),
         "elastic_change": e1["elastic"] - e0["elastic"],
     }
-    mech = energy["kinetic"] + energy["potential_change"] + energy["elastic_change"]
+    mech = energy["kinetic_change"] + energy["potential_change"] + energy["elastic_change"]
     losses = energy["damping"] + energy["friction"] + energy["crushing"]
     work = energy["ground_work"] + energy["wind_work"]
-    scale = max(abs(work), losses, abs(mech), e0["elastic"] * 1e-3, 1e-300)
+    # relative to the largest energy exchanged (the kinetic energy at either end, the work, the
+    # losses or the change of the potential or elastic energy)
+    scale = max(abs(work), losses, e0["kinetic"], e1["kinetic"], abs(energy["potential_change"]),
+                abs(energy["elastic_change"]), 1e-300)
     energy["residual"] = (work - mech - losses) / scale
     return _result(section, asm, init, hist_x[:n_hist], hist_n[:n_hist], hist_t[:n_hist], dt, t,
                    ev_t[:min(n_ev, log)], ev_kind[:min(n_ev, log)], ev_index[:min(n_ev, log)],
