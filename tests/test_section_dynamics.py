@@ -176,3 +176,22 @@ def test_crushed_caps_never_spring_back():
     # the crushing loss is the proportional-limit force times the set, spring by spring
     fy = assemble(sec).spring_f[:, K.PF_FY]
     assert res.energy["crushing"] == pytest.approx(float(fy @ res.plastic_set), rel=1e-9)
+
+
+@pytest.mark.parametrize("seed, moving", [(1, True), (2, False), (3, True)])
+def test_friction_stays_in_its_cone_and_tolerances_agree(seed, moving):
+    """No event missed: at every sample each strip's tangential force is within mu_s times its
+    normal force (a strip that closes while sliding, or a slip onset skipped, would break it), and
+    a run at a 1e4 times tighter tolerance gives the same demand parameters."""
+    sec = dock(damping=0.15, moving_sides=moving, e_g=0.05 * seed)
+    h, v, dt = strong_motion(0.5 + 0.1 * seed, seed=seed)
+    res = simulate_section(sec, h, v, dt, rtol=1e-6, atol=1e-9)
+    tight = simulate_section(sec, h, v, dt, rtol=1e-10, atol=1e-13)
+    for name in res.normal:
+        n, f = res.normal[name], res.friction[name]
+        mu_s = 0.5
+        assert np.all(np.abs(f) <= mu_s * n * (1 + 1e-6) + 1e-6 * np.abs(n).max()), name
+    for key in ("peak_sway", "peak_roll", "keel_peak_load_per_block", "side1_peak_load_per_block",
+                "side0_peak_slip", "keel_peak_slip"):
+        assert res.summary[key] == pytest.approx(tight.summary[key], rel=2e-3, abs=1e-9), key
+    assert abs(res.energy["residual"]) < ENERGY_TOL and abs(tight.energy["residual"]) < 1e-8

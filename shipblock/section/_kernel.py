@@ -119,7 +119,7 @@ def cap_surface(k, c, dp, dc0, t0, t):
 
 
 @njit(cache=True)
-def contact_forces(x, u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, delta_dot, vt,
+def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, delta_dot, vt,
                    fe, fn, normal, tang):
     """Spring forces (total ``fn``, elastic ``fe``) and strip normal/tangential forces."""
     for j in range(strip_i.shape[0]):
@@ -139,7 +139,7 @@ def contact_forces(x, u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, del
             total += fn[i]
         normal[j] = total
         if fs[j] == F_STICK:
-            tang[j] = -strip_f[j, SF_KT] * u[j] - strip_f[j, SF_CT] * vt[j]
+            tang[j] = -strip_f[j, SF_KT] * x[o_u + j] - strip_f[j, SF_CT] * vt[j]
         elif fs[j] == F_FREE:
             tang[j] = 0.0
         else:
@@ -152,7 +152,7 @@ def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, op
     """Time derivative of the state (Newton-Euler of every body, contact laws, energy rates)."""
     kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
     o_u = 6 * nb
-    contact_forces(x, x[o_u:o_u + ns], nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
+    contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
                    delta_dot, vt, fe, fn, normal, tang)
     # ground acceleration, linear between samples
     s = t / dt_rec
@@ -249,7 +249,7 @@ def event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs
     """Event functions of the current regimes: an event happens when one goes from > 0 to <= 0."""
     kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
     o_u = 6 * nb
-    contact_forces(x, x[o_u:o_u + ns], nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
+    contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
                    delta_dot, vt, fe, fn, normal, tang)
     nsp = spring_f.shape[0]
     min_gap = BIG
@@ -371,7 +371,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     h = min(h_max, 1e-4)
     # the first history sample is the initial state
     kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
-    contact_forces(x, x[6 * nb:6 * nb + ns], nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
+    contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
                    delta_dot, vt, fe, fn, normal, tang)
     n_samples = hist_x.shape[0]
     for m in range(nx):
@@ -385,7 +385,14 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
         dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
     event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
                  delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
-    while t < t_end:
+    failure, n_ev = _settle(t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs,
+                            opt, delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0,
+                            acc, n_ev, ev_t, ev_kind, ev_index)
+    rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
+        dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
+    event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
+                 delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
+    while t < t_end and failure == 0:
         # steps end on the input samples (the input is linear between them)
         t_next = (math.floor(t / dt_rec + 1e-9) + 1.0) * dt_rec
         if t_end - t < 1e-12 * dt_rec:
@@ -451,7 +458,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
         lo, hi = 0.0, 1.0
         for q in range(ng):
             if g0[q] > 0.0 and g1[q] <= 0.0:
-                a, b = 0.0, 1.0
+                a, b, ga, gb = 0.0, 1.0, g0[q], g1[q]
                 if first >= 0:
                     # only look before the earliest one found so far
                     dense(r, hi, xe)
@@ -460,19 +467,31 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
                                  tang, theta_c, ge)
                     if ge[q] > 0.0:
                         continue
-                    b = hi
-                for _ in range(60):
-                    mid = 0.5 * (a + b)
+                    b, gb = hi, ge[q]
+                # Illinois (regula falsi with halving of the stale end's value)
+                side = 0
+                for _ in range(100):
+                    if (b - a) * h < 1e-12:
+                        break
+                    mid = (a * gb - b * ga) / (gb - ga)
+                    # stay strictly inside, and bisect when the secant hugs an end
+                    if not (a + 0.01 * (b - a) < mid < b - 0.01 * (b - a)):
+                        mid = min(max(mid, a + 0.01 * (b - a)), b - 0.01 * (b - a))
                     dense(r, mid, xe)
                     event_values(t + mid * h, xe, nb, ns, strip_f, strip_i, spring_f, reg, dp,
                                  dc0, tc0, fs, opt, delta, delta_dot, vt, pos, fe, fn, normal,
                                  tang, theta_c, ge)
-                    if ge[q] > 0.0:
-                        a = mid
+                    gm = ge[q]
+                    if gm > 0.0:
+                        a, ga = mid, gm
+                        if side == 1:
+                            gb *= 0.5
+                        side = 1
                     else:
-                        b = mid
-                    if (b - a) * h < 1e-13:
-                        break
+                        b, gb = mid, gm
+                        if side == -1:
+                            ga *= 0.5
+                        side = -1
                 first, lo, hi = q, a, b
         t_new = t + h if first < 0 else t + hi * h
         if first >= 0:
@@ -484,7 +503,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             ts = n_hist * dt_rec
             dense(r, min(1.0, max(0.0, (ts - t) / h)), xe)
             kinematics(xe, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
-            contact_forces(xe, xe[6 * nb:6 * nb + ns], nb, strip_f, strip_i, spring_f, reg, dp,
+            contact_forces(xe, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp,
                            fs, delta, delta_dot, vt, fe, fn, normal, tang)
             for m in range(nx):
                 hist_x[n_hist, m] = xe[m]
@@ -496,19 +515,20 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
         for m in range(nx):
             x[m] = x1[m]
         kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
-        contact_forces(x, x[6 * nb:6 * nb + ns], nb, strip_f, strip_i, spring_f, reg, dp, fs,
+        contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs,
                        delta, delta_dot, vt, fe, fn, normal, tang)
         _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n)
         if first >= 0:
             kind, index = _transition(first, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg,
                                       dp, dc0, tc0, fs, delta, normal, tang, acc)
-            if n_ev < ev_t.shape[0]:
-                ev_t[n_ev] = t
-                ev_kind[n_ev] = kind
-                ev_index[n_ev] = index
-            n_ev += 1
+            n_ev = _log(n_ev, t, kind, index, ev_t, ev_kind, ev_index)
             if kind >= EV_OVERTURN:
                 failure = kind
+                break
+            failure, n_ev = _settle(t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0,
+                                    tc0, fs, opt, delta, delta_dot, vt, pos, fe, fn, normal, tang,
+                                    theta_c, g0, acc, n_ev, ev_t, ev_kind, ev_index)
+            if failure != 0:
                 break
             if n_ev > max_events:
                 failure = EV_STALL
@@ -527,6 +547,40 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             dc0[i] = dp[i] + rem
             tc0[i] = t
     return t, n_ev, failure, n_hist, n_acc, n_rej
+
+
+@njit(cache=True)
+def _log(n_ev, t, kind, index, ev_t, ev_kind, ev_index):
+    if n_ev < ev_t.shape[0]:
+        ev_t[n_ev] = t
+        ev_kind[n_ev] = kind
+        ev_index[n_ev] = index
+    return n_ev + 1
+
+
+@njit(cache=True)
+def _settle(t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
+            delta_dot, vt, pos, fe, fn, normal, tang, theta_c, gv, acc, n_ev, ev_t, ev_kind,
+            ev_index):
+    """Make the regimes consistent with the state after an event: while an event function is
+    negative (a strip that closes sliding, a spring closing on a cap it then pulls...), apply its
+    transition at the same instant. Returns (failure code or 0, events logged)."""
+    for _ in range(4 * (nsp + ns) + 8):
+        event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
+                     delta_dot, vt, pos, fe, fn, normal, tang, theta_c, gv)
+        q = -1
+        for m in range(gv.shape[0]):
+            if gv[m] < 0.0:
+                q = m
+                break
+        if q < 0:
+            return 0, n_ev
+        kind, index = _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0,
+                                  tc0, fs, delta, normal, tang, acc)
+        n_ev = _log(n_ev, t, kind, index, ev_t, ev_kind, ev_index)
+        if kind >= EV_OVERTURN:
+            return kind, n_ev
+    return EV_STALL, n_ev
 
 
 @njit(cache=True)
@@ -579,9 +633,10 @@ def _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, 
         if reg[i] == R_ELASTIC:
             reg[i] = R_CRUSH
             return EV_CRUSH, i
-        # crushing ends: the set is kept
+        # crushing ends: the set is kept (a hair short of the yield force, so that rounding
+        # cannot restart the crushing at once)
         reg[i] = R_ELASTIC
-        dp[i] = delta[i] - fy / k
+        dp[i] = delta[i] - fy / k * (1.0 - 1e-12)
         return EV_UNLOAD, i
     if q < 2 * nsp + ns:
         j = q - 2 * nsp
@@ -595,7 +650,8 @@ def _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, 
         # stick again with the spring preloaded to the kinetic friction force, so that the force is
         # continuous; its energy is booked against the friction loss (it is given back at the next
         # slip onset, or stays stored)
-        u = fs[j] * strip_f[j, SF_MUK] * normal[j] / strip_f[j, SF_KT]
+        # (a hair below it, so that with mu_s = mu_k rounding cannot slip it again at once)
+        u = fs[j] * strip_f[j, SF_MUK] * normal[j] * (1.0 - 1e-9) / strip_f[j, SF_KT]
         acc[A_FRIC_EVENT] -= 0.5 * strip_f[j, SF_KT] * u * u
         fs[j] = F_STICK
         x[o_u + j] = u
