@@ -71,7 +71,7 @@ def _vel(x, nb, body):
     return x[o], x[o + 1], x[o + 2]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
     """Closure and closure rate of every spring, tangential slip rate of every strip.
 
@@ -110,7 +110,7 @@ def kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
         vt[j] = (vcy - vsy) * nz - (vcz - vsz) * ny
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def cap_surface(k, c, dp, dc0, t0, t):
     """Compression of a detached cap at time t: it relaxes from dc0 towards its set dp."""
     if c <= 0.0 or dc0 <= dp:
@@ -118,7 +118,7 @@ def cap_surface(k, c, dp, dc0, t0, t):
     return dp + (dc0 - dp) * math.exp(-(k / c) * (t - t0))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, delta_dot, vt,
                    fe, fn, normal, tang):
     """Spring forces (total ``fn``, elastic ``fe``) and strip normal/tangential forces."""
@@ -537,7 +537,8 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
         event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
                      delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
-        # step-size controller (elementary, order 5 solution with a 4th-order error estimate)
+        # step-size controller (elementary, order 5 solution with a 4th-order error estimate;
+        # Hairer's stabilised controller was tried: fewer rejections, as many evaluations)
         h = h * min(5.0, max(0.2, 0.9 * max(err, 1e-10) ** -0.2))
     # energy left in detached caps is not lost yet: count only what they have shed
     for i in range(nsp):

@@ -23,7 +23,7 @@ __all__ = ["EVENT_NAMES", "FAILURE_NAMES", "SectionResult", "simulate_section",
            "simulate_section_batch"]
 
 #: Default relative and absolute tolerances of the integration (SI units of each state).
-DEFAULT_RTOL = 1e-7
+DEFAULT_RTOL = 1e-6
 DEFAULT_ATOL = 1e-9
 #: Default lift of the ship off every support at which the run stops as a separation [m].
 DEFAULT_SEPARATION_HEIGHT = 0.02
