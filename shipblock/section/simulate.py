@@ -66,6 +66,8 @@ class SectionResult:
     normal, friction : dict
         Per strip name (``"keel_top"``, ``"keel_bottom"``, ...) the normal and tangential force per
         block [N], shape (n,).
+    ship_velocity : ndarray, shape (n, 3)
+        Ship's ``(v_y, v_z, omega)`` [m/s, m/s, rad/s].
     ship_sway : ndarray
         Horizontal offset of the keel's centre from the keel block's top centre, from its static
         value [m].
@@ -86,6 +88,7 @@ class SectionResult:
 
     time: np.ndarray
     ship: np.ndarray
+    ship_velocity: np.ndarray
     lines: dict
     normal: dict
     friction: dict
@@ -382,8 +385,7 @@ def _result(section, asm, init, hx, hn, ht, dt, t_final, ev_t, ev_kind, ev_index
         else:
             where = "ship"
         events.append(SectionEvent(float(tt), kind, where))
-    del nb
-    return SectionResult(time, ship, lines, normal, friction, sway, events, fail,
+    return SectionResult(time, ship, hx[:, 3 * nb:3 * nb + 3].copy(), lines, normal, friction, sway, events, fail,
                          summary["failure_time"], summary, energy, stats, dp.copy(), names,
                          section)
 
