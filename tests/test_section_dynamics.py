@@ -197,25 +197,25 @@ def test_friction_stays_in_its_cone_and_tolerances_agree(seed, moving):
     assert abs(res.energy["residual"]) < ENERGY_TOL and abs(tight.energy["residual"]) < 1e-8
 
 
-@pytest.mark.parametrize("zeta", [0.0, 0.2, 0.8])
+@pytest.mark.parametrize("zeta", [0.0, 0.3, 0.8])
 def test_normal_impact_restitution_follows_the_damping_mapping(zeta):
     """The ship tossed up from its keel line falls back on the top caps and rebounds with the
     restitution of the linear spring-dashpot with force-based separation
-    (:func:`impact_restitution`). Bottom caps 200 times stiffer than the top caps, so that the
-    contact is the one-mass model to ~3e-3 (the bottom caps' compliance and gravity during the
-    0.7 ms contact; measured 3e-3 at 200 times, 1e-3 at 1000 times, which runs 10 times longer).
-    The tolerance, 6e-3, is far below the 8 % between this law and the naive exp(-pi zeta / s)."""
+    (:func:`impact_restitution`). Bottom caps 1000 times stiffer than the top caps, so that the
+    contact is the one-mass model to ~1e-3 (the bottom caps' compliance and gravity during the
+    0.7 ms contact; at 200 times the difference is 3e-3 for zeta 0.2 and 1.2e-2 for 0.8). The
+    tolerance, 3e-3, is far below the 8 % between this law and the naive exp(-pi zeta / s)."""
     from shipblock.section.model import damping_for_restitution, impact_restitution
 
     top = Cap(stiffness=1e12, damping_ratio=zeta, proportional_limit=1e10)
-    bottom = Cap(stiffness=2e14, damping_ratio=0.5, proportional_limit=1e10)
+    bottom = Cap(stiffness=1e15, damping_ratio=0.5, proportional_limit=1e10)
     ship = Ship(mass=2e5, roll_inertia=2e5 * 4, g_height=3.0, keel_half_width=1.0,
                 half_beam=5.0)
     sec = DockSection(ship, BlockLine(block=Block(top=top, bottom=bottom), n_blocks=4))
     v0 = np.zeros((2, 3))
-    v0[0, 1] = 1.5
+    v0[0, 1] = 2.0
     dt = 1e-4
-    res = simulate_section(sec, np.zeros(3500), None, dt, initial_velocity=v0,
+    res = simulate_section(sec, np.zeros(5000), None, dt, initial_velocity=v0,
                            separation_height=0.5, rtol=1e-10, atol=1e-14)
     closes = [e.time for e in res.events if e.kind == "spring_closes" and e.where == "keel_top[0]"]
     leaves = [e.time for e in res.events
@@ -226,6 +226,6 @@ def test_normal_impact_restitution_follows_the_damping_mapping(zeta):
     k_out = int(t_out / dt) + 3
     v_in = res.ship_velocity[k_in, 1] - G * (t_in - res.time[k_in])
     v_out = res.ship_velocity[k_out, 1] + G * (res.time[k_out] - t_out)
-    assert -v_out / v_in == pytest.approx(impact_restitution(zeta), rel=6e-3, abs=1e-4)
+    assert -v_out / v_in == pytest.approx(impact_restitution(zeta), rel=3e-3, abs=1e-4)
     if zeta > 0:
         assert damping_for_restitution(impact_restitution(zeta)) == pytest.approx(zeta, rel=1e-9)
