@@ -14,7 +14,6 @@ ship and friction. The differences must fall as the cap stiffness k grows; the o
 """
 
 import numpy as np
-import pytest
 
 from shipblock import ShipBlockSystem, simulate
 from shipblock.section import Block, BlockLine, Cap, DockSection, Ship
