@@ -156,3 +156,16 @@ def test_caps_crushing_at_rest_are_refused_naming_the_line():
                            half_beam=6.0), BlockLine(block=Block(top=weak), n_blocks=2))
     with pytest.raises(ParameterError, match="DockSection.keel: the top caps would crush"):
         static_state(assemble(sec))
+
+
+def test_a_side_line_that_would_slide_at_rest_is_refused():
+    """One side line under a sloped hull: the static state with the strips sticking needs more
+    friction than mu_s gives; the dock is refused naming the line, not started out of its cone."""
+    slick = Cap(mu_s=0.05, mu_k=0.05)
+    side = BlockLine(block=Block(top=slick, bottom=slick, half_height=24 * 0.0254 + 0.15),
+                     n_blocks=2, offset=3.5, hull_height=0.3, hull_slope=0.3)
+    ship = Ship(mass=6e5, roll_inertia=6e5 * 9.0, g_height=3.0, keel_half_width=0.8,
+                half_beam=6.0, g_offset=0.3)
+    sec = DockSection(ship, BlockLine(n_blocks=4), (side,))
+    with pytest.raises(ParameterError, match=r"DockSection.sides\[0\]: at rest its .* face needs"):
+        static_state(assemble(sec))

@@ -441,4 +441,17 @@ def static_state(asm: Assembly) -> InitialState:
             f"{key}: the {face} caps would crush under the static load (a spring at "
             f"{fn[over].max() / asm.spring_f[over, K.PF_FY].max():.2f} x its proportional-limit "
             "force): the line is overloaded at rest; add blocks or give a stronger cap")
+    # and admissible: every sticking strip inside its friction cone
+    u = x[6 * nb:6 * nb + asm.n_strips]
+    demand = np.abs(asm.strip_f[:, K.SF_KT] * u)
+    for j in range(asm.n_strips):
+        if fs[j] == K.F_STICK and demand[j] > asm.strip_f[j, K.SF_MUS] * normal[j]:
+            li = int(asm.strip_line[j])
+            key = "DockSection.keel" if li == 0 else f"DockSection.sides[{li - 1}]"
+            face = "top" if asm.strip_top[j] else "bottom"
+            raise ParameterError(
+                f"{key}: at rest its {face} face needs a friction coefficient of "
+                f"{demand[j] / normal[j]:.3g}, above its mu_s "
+                f"({asm.strip_f[j, K.SF_MUS]:.3g}): the line would slide under the static load "
+                "(a hull slope too steep for the friction, or an unbalanced side line)")
     return InitialState(x, reg, np.zeros(asm.spring_f.shape[0]), fs, normal, fn)
