@@ -1,0 +1,672 @@
+"""Compiled kernel of the dock-section model: forces, events and the event-driven integrator.
+
+The section is a set of rigid bodies in the transverse plane (body 0 the ship; then every moving
+block line), each with state ``(y, z, angle)`` in the floor's frame, joined by *strips*: the cap
+of a block face (carried by body ``C``: a moving line, or a fixed line whose pose is given)
+pressed against a straight surface of body ``S`` (the ship's hull, or the floor). A strip holds
+``n`` compression-only springs at Gauss-Lobatto points of the face and one tangential stick spring
+at the face's centre. :mod:`shipblock.section.model` explains every law; this module only
+evaluates them.
+
+State vector: ``q`` (3 per body), ``v`` (3 per body), ``u`` (stick-spring extension per strip),
+then the running integrals ``W_ground, W_wind, D_damping, D_friction`` (not error-controlled).
+
+Integrator: Dormand-Prince 5(4) with Hairer's 4th-order dense output; events (a spring
+closing, detaching, starting or ending to crush; a strip sticking, slipping; failures) are
+sign changes of event functions between the ends of an accepted step, located on the dense
+output by bisection, and the run restarts just past the earliest one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+# --- layout of the strip and spring tables -------------------------------------------------
+SF_SQY, SF_SQZ, SF_SNY, SF_SNZ, SF_CY, SF_CZ, SF_KT, SF_CT, SF_MUS, SF_MUK = range(10)
+SF_PY, SF_PZ, SF_PA = 10, 11, 12  # fixed pose of C when C is not a body
+N_SF = 13
+SI_C, SI_S, SI_FIRST, SI_COUNT = range(4)
+N_SI = 4
+PF_RY, PF_RZ, PF_K, PF_C, PF_FY, PF_AREA = range(6)
+N_PF = 6
+
+# --- regimes -----------------------------------------------------------------------------
+R_FREE, R_ELASTIC, R_CRUSH = 0, 1, 2  # spring: not carrying / elastic / crushing
+F_STICK, F_FREE = 0, 2  # strip: stick, +1/-1 slip in that direction of v_t, free (no load)
+
+# --- event kinds (codes in the event log) -------------------------------------------------
+EV_START, EV_CLOSE, EV_DETACH, EV_CRUSH, EV_UNLOAD, EV_SLIP, EV_STICK = 0, 1, 2, 3, 4, 5, 6
+EV_STRIP_OPEN, EV_STRIP_CLOSE = 7, 8
+EV_OVERTURN, EV_SLID_OFF, EV_TIP, EV_SEPARATION, EV_INVALID, EV_STALL = 10, 11, 12, 13, 14, 15
+EV_END = 20
+
+# --- options vector --------------------------------------------------------------------------
+O_G, O_WIND_F, O_WIND_Y, O_WIND_Z, O_ROLL_HELD, O_SEP, O_TIP_POS, O_TIP_NEG = range(8)
+O_KEEL_B, O_KEEL_TOP_Y, O_KEEL_TOP_Z, O_SHIP_KY, O_SHIP_KZ = 8, 9, 10, 11, 12
+O_MAX_ANGLE, O_MAX_DISP = 13, 14
+N_OPT = 15
+
+# --- running totals (acc) ------------------------------------------------------------------------
+A_FRIC_EVENT, A_CAP_RELAX = 0, 1
+N_ACC = 2
+
+BIG = 1e300
+
+
+@njit(cache=True, inline="always")
+def _pose(x, body, fy, fz, fa):
+    if body < 0:
+        return fy, fz, fa
+    return x[3 * body], x[3 * body + 1], x[3 * body + 2]
+
+
+@njit(cache=True, inline="always")
+def _vel(x, nb, body):
+    if body < 0:
+        return 0.0, 0.0, 0.0
+    o = 3 * nb + 3 * body
+    return x[o], x[o + 1], x[o + 2]
+
+
+@njit(cache=True, inline="always")
+def kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
+    """Closure and closure rate of every spring, tangential slip rate of every strip.
+
+    ``pos[i] = (py, pz)`` is the world position of spring i's point on C (where its force acts).
+    """
+    for j in range(strip_i.shape[0]):
+        cb, sb = strip_i[j, SI_C], strip_i[j, SI_S]
+        cy, cz, ca = _pose(x, cb, strip_f[j, SF_PY], strip_f[j, SF_PZ], strip_f[j, SF_PA])
+        sy, sz, sa = _pose(x, sb, 0.0, 0.0, 0.0)
+        cvy, cvz, cw = _vel(x, nb, cb)
+        svy, svz, sw = _vel(x, nb, sb)
+        cc, cs = math.cos(ca), math.sin(ca)
+        sc, ss = math.cos(sa), math.sin(sa)
+        ny = sc * strip_f[j, SF_SNY] - ss * strip_f[j, SF_SNZ]
+        nz = ss * strip_f[j, SF_SNY] + sc * strip_f[j, SF_SNZ]
+        qy = sy + sc * strip_f[j, SF_SQY] - ss * strip_f[j, SF_SQZ]
+        qz = sz + ss * strip_f[j, SF_SQY] + sc * strip_f[j, SF_SQZ]
+        first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
+        for i in range(first, first + count):
+            ry, rz = spring_f[i, PF_RY], spring_f[i, PF_RZ]
+            py = cy + cc * ry - cs * rz
+            pz = cz + cs * ry + cc * rz
+            pos[i, 0] = py
+            pos[i, 1] = pz
+            delta[i] = (qy - py) * ny + (qz - pz) * nz
+            # velocities of the body-fixed points of S and C at p
+            vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
+            vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
+            delta_dot[i] = (vsy - vcy) * ny + (vsz - vcz) * nz
+        ry, rz = strip_f[j, SF_CY], strip_f[j, SF_CZ]
+        py = cy + cc * ry - cs * rz
+        pz = cz + cs * ry + cc * rz
+        vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
+        vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
+        # tangent t = (n_z, -n_y): (1, 0) on the floor
+        vt[j] = (vcy - vsy) * nz - (vcz - vsz) * ny
+
+
+@njit(cache=True, inline="always")
+def cap_surface(k, c, dp, dc0, t0, t):
+    """Compression of a detached cap at time t: it relaxes from dc0 towards its set dp."""
+    if c <= 0.0 or dc0 <= dp:
+        return dp
+    return dp + (dc0 - dp) * math.exp(-(k / c) * (t - t0))
+
+
+@njit(cache=True, inline="always")
+def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, delta_dot, vt,
+                   fe, fn, normal, tang):
+    """Spring forces (total ``fn``, elastic ``fe``) and strip normal/tangential forces."""
+    for j in range(strip_i.shape[0]):
+        first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
+        total = 0.0
+        for i in range(first, first + count):
+            k, c, fy = spring_f[i, PF_K], spring_f[i, PF_C], spring_f[i, PF_FY]
+            if reg[i] == R_ELASTIC:
+                fe[i] = k * (delta[i] - dp[i])
+                fn[i] = fe[i] + c * delta_dot[i]
+            elif reg[i] == R_CRUSH:
+                fe[i] = fy
+                fn[i] = fy + c * delta_dot[i]
+            else:
+                fe[i] = 0.0
+                fn[i] = 0.0
+            total += fn[i]
+        normal[j] = total
+        if fs[j] == F_STICK:
+            tang[j] = -strip_f[j, SF_KT] * x[o_u + j] - strip_f[j, SF_CT] * vt[j]
+        elif fs[j] == F_FREE:
+            tang[j] = 0.0
+        else:
+            tang[j] = -fs[j] * strip_f[j, SF_MUK] * total
+
+
+@njit(cache=True)
+def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
+        dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, xdot):
+    """Time derivative of the state (Newton-Euler of every body, contact laws, energy rates)."""
+    kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
+    o_u = 6 * nb
+    contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
+                   delta_dot, vt, fe, fn, normal, tang)
+    # ground acceleration, linear between samples
+    s = t / dt_rec
+    k = int(s)
+    if k >= ag_y.shape[0] - 1:
+        ay, az = ag_y[-1], ag_z[-1]
+    else:
+        w = s - k
+        ay = ag_y[k] + w * (ag_y[k + 1] - ag_y[k])
+        az = ag_z[k] + w * (ag_z[k + 1] - ag_z[k])
+    g = opt[O_G]
+    for b in range(nb):
+        xdot[3 * b] = x[3 * nb + 3 * b]
+        xdot[3 * b + 1] = x[3 * nb + 3 * b + 1]
+        xdot[3 * b + 2] = x[3 * nb + 3 * b + 2]
+        xdot[3 * nb + 3 * b] = -mass[b] * ay
+        xdot[3 * nb + 3 * b + 1] = -mass[b] * (g + az)
+        xdot[3 * nb + 3 * b + 2] = 0.0
+    d_damp = 0.0
+    d_fric = 0.0
+    for j in range(ns):
+        cb, sb = strip_i[j, SI_C], strip_i[j, SI_S]
+        cy, cz, ca = _pose(x, cb, strip_f[j, SF_PY], strip_f[j, SF_PZ], strip_f[j, SF_PA])
+        sy, sz, sa = _pose(x, sb, 0.0, 0.0, 0.0)
+        sc, ss = math.cos(sa), math.sin(sa)
+        ny = sc * strip_f[j, SF_SNY] - ss * strip_f[j, SF_SNZ]
+        nz = ss * strip_f[j, SF_SNY] + sc * strip_f[j, SF_SNZ]
+        first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
+        for i in range(first, first + count):
+            f = fn[i]
+            if reg[i] != R_FREE:
+                d_damp += spring_f[i, PF_C] * delta_dot[i] * delta_dot[i]
+            if f == 0.0:
+                continue
+            py, pz = pos[i, 0], pos[i, 1]
+            fy_, fz_ = f * ny, f * nz
+            if cb >= 0:
+                xdot[3 * nb + 3 * cb] += fy_
+                xdot[3 * nb + 3 * cb + 1] += fz_
+                xdot[3 * nb + 3 * cb + 2] += (py - cy) * fz_ - (pz - cz) * fy_
+            if sb >= 0:
+                xdot[3 * nb + 3 * sb] -= fy_
+                xdot[3 * nb + 3 * sb + 1] -= fz_
+                xdot[3 * nb + 3 * sb + 2] -= (py - sy) * fz_ - (pz - sz) * fy_
+        ft = tang[j]
+        xdot[o_u + j] = vt[j] if fs[j] == F_STICK else 0.0
+        if fs[j] == F_STICK:
+            d_damp += strip_f[j, SF_CT] * vt[j] * vt[j]
+        elif fs[j] != F_FREE:
+            d_fric += -ft * vt[j]
+        if ft != 0.0:
+            cc, cs = math.cos(ca), math.sin(ca)
+            ry, rz = strip_f[j, SF_CY], strip_f[j, SF_CZ]
+            py = cy + cc * ry - cs * rz
+            pz = cz + cs * ry + cc * rz
+            fy_, fz_ = ft * nz, -ft * ny  # along t = (n_z, -n_y)
+            if cb >= 0:
+                xdot[3 * nb + 3 * cb] += fy_
+                xdot[3 * nb + 3 * cb + 1] += fz_
+                xdot[3 * nb + 3 * cb + 2] += (py - cy) * fz_ - (pz - cz) * fy_
+            if sb >= 0:
+                xdot[3 * nb + 3 * sb] -= fy_
+                xdot[3 * nb + 3 * sb + 1] -= fz_
+                xdot[3 * nb + 3 * sb + 2] -= (py - sy) * fz_ - (pz - sz) * fy_
+    # wind on the ship at its point (O_WIND_Y, O_WIND_Z) in the ship's frame
+    fw = opt[O_WIND_F]
+    w_wind = 0.0
+    if fw != 0.0:
+        ca, sa = math.cos(x[2]), math.sin(x[2])
+        rz = sa * opt[O_WIND_Y] + ca * opt[O_WIND_Z]
+        xdot[3 * nb] += fw
+        xdot[3 * nb + 2] += -rz * fw
+        w_wind = fw * (x[3 * nb] - x[3 * nb + 2] * rz)
+    w_ground = 0.0
+    for b in range(nb):
+        o = 3 * nb + 3 * b
+        w_ground -= mass[b] * (ay * x[o] + az * x[o + 1])
+        xdot[o] /= mass[b]
+        xdot[o + 1] /= mass[b]
+        xdot[o + 2] /= inertia[b]
+    if opt[O_ROLL_HELD] != 0.0:
+        xdot[2] = 0.0
+        xdot[3 * nb + 2] = 0.0
+    o_e = o_u + ns
+    xdot[o_e] = w_ground
+    xdot[o_e + 1] = w_wind
+    xdot[o_e + 2] = d_damp
+    xdot[o_e + 3] = d_fric
+
+
+@njit(cache=True)
+def event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
+                 delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, gv):
+    """Event functions of the current regimes: an event happens when one goes from > 0 to <= 0."""
+    kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
+    o_u = 6 * nb
+    contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
+                   delta_dot, vt, fe, fn, normal, tang)
+    nsp = spring_f.shape[0]
+    min_gap = BIG
+    for j in range(ns):
+        first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
+        for i in range(first, first + count):
+            k, c = spring_f[i, PF_K], spring_f[i, PF_C]
+            if reg[i] == R_FREE:
+                gv[2 * i] = cap_surface(k, c, dp[i], dc0[i], tc0[i], t) - delta[i]
+                gv[2 * i + 1] = BIG
+            elif reg[i] == R_ELASTIC:
+                gv[2 * i] = fn[i] / k  # detaches when the force would pull
+                gv[2 * i + 1] = (spring_f[i, PF_FY] - fe[i]) / k  # starts to crush
+            else:
+                gv[2 * i] = delta_dot[i]  # stops crushing when it unloads
+                gv[2 * i + 1] = BIG
+            if strip_i[j, SI_S] == 0:
+                min_gap = min(min_gap, dp[i] - delta[i])
+        if fs[j] == F_STICK:
+            gv[2 * nsp + j] = (strip_f[j, SF_MUS] * normal[j] - abs(tang[j])) / strip_f[j, SF_KT]
+        elif fs[j] == F_FREE:
+            gv[2 * nsp + j] = BIG
+        else:
+            gv[2 * nsp + j] = fs[j] * vt[j]
+    o = 2 * nsp + ns
+    for b in range(1, nb):
+        gv[o + b - 1] = theta_c[b] - abs(x[3 * b + 2])
+    o += nb - 1
+    # ship slid off the keel line's top: keel centre vs the keel block's top centre
+    ca, sa = math.cos(x[2]), math.sin(x[2])
+    ky = x[0] + ca * opt[O_SHIP_KY] - sa * opt[O_SHIP_KZ]
+    cb, sb = math.cos(x[5]), math.sin(x[5])
+    ty = x[3] + cb * opt[O_KEEL_TOP_Y] - sb * opt[O_KEEL_TOP_Z]
+    gv[o] = opt[O_KEEL_B] - abs(ky - ty)
+    phi = x[2]
+    gv[o + 1] = opt[O_TIP_POS] - phi if phi >= 0.0 else opt[O_TIP_NEG] + phi
+    gv[o + 2] = opt[O_SEP] - min_gap
+    # validity: displacements and rotations within what the model is written for
+    worst = 0.0
+    for b in range(nb):
+        worst = max(worst, abs(x[3 * b]) / opt[O_MAX_DISP])
+        worst = max(worst, abs(x[3 * b + 2]) / opt[O_MAX_ANGLE])
+    gv[o + 3] = 1.0 - worst
+
+
+# Dormand-Prince 5(4) coefficients (Dormand and Prince 1980) and Hairer's dense output.
+_A21 = 1.0 / 5.0
+_A31, _A32 = 3.0 / 40.0, 9.0 / 40.0
+_A41, _A42, _A43 = 44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0
+_A51, _A52, _A53, _A54 = 19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0
+_A61, _A62, _A63 = 9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0
+_A64, _A65 = 49.0 / 176.0, -5103.0 / 18656.0
+_B1, _B3, _B4, _B5, _B6 = 35.0 / 384.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0
+_E1, _E3, _E4 = 71.0 / 57600.0, -71.0 / 16695.0, 71.0 / 1920.0
+_E5, _E6, _E7 = -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0
+_D1, _D3, _D4 = -12715105075.0 / 11282082432.0, 87487479700.0 / 32700410799.0, \
+    -10690763975.0 / 1880347072.0
+_D5, _D6, _D7 = 701980252875.0 / 199316789632.0, -1453857185.0 / 822651844.0, \
+    69997945.0 / 29380423.0
+
+
+@njit(cache=True)
+def dense(r, theta, out):
+    """State at ``t0 + theta h`` from the dense-output coefficients ``r`` (5 rows)."""
+    th1 = 1.0 - theta
+    for m in range(out.shape[0]):
+        out[m] = r[0, m] + theta * (r[1, m] + th1 * (r[2, m] + theta * (r[3, m] + th1 * r[4, m])))
+
+
+@njit(cache=True)
+def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f, opt, theta_c, ag_y, ag_z,
+        dt_rec, t_end, rtol, atol, h_max, max_events, hist_x, hist_n, hist_t, ev_t, ev_kind,
+        ev_index, acc, peak_fe, peak_fn, peak_util, peak_n):
+    """Integrate from t = 0 to ``t_end`` or the first failure; returns (t_final, n_events, failure
+    code, number of history samples written, accepted steps, rejected steps).
+
+    ``x``, ``reg``, ``dp``, ``fs`` are updated in place (the final state); ``dc0``, ``tc0`` hold
+    the compression of every detached cap and the time it let go (start with ``dc0 = dp``). Histories are written
+    at ``k dt_rec``; peaks of the elastic and total spring forces and of the strips' friction
+    utilisation are kept at every accepted step end and event.
+    """
+    ns = strip_i.shape[0]
+    nsp = spring_f.shape[0]
+    nx = x.shape[0]
+    n_err = 6 * nb + ns
+    ng = 2 * nsp + ns + (nb - 1) + 4
+    delta = np.zeros(nsp)
+    delta_dot = np.zeros(nsp)
+    vt = np.zeros(ns)
+    pos = np.zeros((nsp, 2))
+    fe = np.zeros(nsp)
+    fn = np.zeros(nsp)
+    normal = np.zeros(ns)
+    tang = np.zeros(ns)
+    k1 = np.zeros(nx)
+    k2 = np.zeros(nx)
+    k3 = np.zeros(nx)
+    k4 = np.zeros(nx)
+    k5 = np.zeros(nx)
+    k6 = np.zeros(nx)
+    k7 = np.zeros(nx)
+    y = np.zeros(nx)
+    x1 = np.zeros(nx)
+    xe = np.zeros(nx)
+    r = np.zeros((5, nx))
+    g0 = np.zeros(ng)
+    g1 = np.zeros(ng)
+    ge = np.zeros(ng)
+    t = 0.0
+    n_ev = 0
+    ev_t[0] = 0.0
+    ev_kind[0] = EV_START
+    ev_index[0] = -1
+    n_ev = 1
+    failure = 0
+    n_hist = 0
+    n_acc = 0
+    n_rej = 0
+    h = min(h_max, 1e-4)
+    # the first history sample is the initial state
+    kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
+    contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
+                   delta_dot, vt, fe, fn, normal, tang)
+    n_samples = hist_x.shape[0]
+    for m in range(nx):
+        hist_x[0, m] = x[m]
+    for j in range(ns):
+        hist_n[0, j] = normal[j]
+        hist_t[0, j] = tang[j]
+    n_hist = 1
+    _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n)
+    rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
+        dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
+    event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
+                 delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
+    failure, n_ev = _settle(t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs,
+                            opt, delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0,
+                            acc, n_ev, ev_t, ev_kind, ev_index)
+    rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
+        dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
+    event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
+                 delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
+    while t < t_end and failure == 0:
+        # steps end on the input samples (the input is linear between them)
+        t_next = (math.floor(t / dt_rec + 1e-9) + 1.0) * dt_rec
+        if t_end - t < 1e-12 * dt_rec:
+            break
+        h = min(h, h_max, t_next - t, t_end - t)
+        if h < 1e-15 * max(1.0, t):
+            failure = EV_STALL
+            break
+        for m in range(nx):
+            y[m] = x[m] + h * _A21 * k1[m]
+        rhs(t + h / 5.0, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
+            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k2)
+        for m in range(nx):
+            y[m] = x[m] + h * (_A31 * k1[m] + _A32 * k2[m])
+        rhs(t + 0.3 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
+            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k3)
+        for m in range(nx):
+            y[m] = x[m] + h * (_A41 * k1[m] + _A42 * k2[m] + _A43 * k3[m])
+        rhs(t + 0.8 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
+            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k4)
+        for m in range(nx):
+            y[m] = x[m] + h * (_A51 * k1[m] + _A52 * k2[m] + _A53 * k3[m] + _A54 * k4[m])
+        rhs(t + 8.0 / 9.0 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs,
+            opt, ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k5)
+        for m in range(nx):
+            y[m] = x[m] + h * (_A61 * k1[m] + _A62 * k2[m] + _A63 * k3[m] + _A64 * k4[m]
+                               + _A65 * k5[m])
+        rhs(t + h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
+            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k6)
+        for m in range(nx):
+            x1[m] = x[m] + h * (_B1 * k1[m] + _B3 * k3[m] + _B4 * k4[m] + _B5 * k5[m]
+                                + _B6 * k6[m])
+        rhs(t + h, x1, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
+            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k7)
+        err = 0.0
+        for m in range(n_err):
+            e = h * (_E1 * k1[m] + _E3 * k3[m] + _E4 * k4[m] + _E5 * k5[m] + _E6 * k6[m]
+                     + _E7 * k7[m])
+            sc = atol + rtol * max(abs(x[m]), abs(x1[m]))
+            err += (e / sc) ** 2
+        err = math.sqrt(err / n_err)
+        if not (err <= 1.0):
+            n_rej += 1
+            if err != err:
+                h *= 0.1
+            else:
+                h *= max(0.1, 0.9 * err ** -0.2)
+            continue
+        n_acc += 1
+        # dense output (Hairer's contd5)
+        for m in range(nx):
+            d = x1[m] - x[m]
+            r[0, m] = x[m]
+            r[1, m] = d
+            r[2, m] = h * k1[m] - d
+            r[3, m] = d - h * k7[m] - r[2, m]
+            r[4, m] = h * (_D1 * k1[m] + _D3 * k3[m] + _D4 * k4[m] + _D5 * k5[m] + _D6 * k6[m]
+                           + _D7 * k7[m])
+        event_values(t + h, x1, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
+                     delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g1)
+        # the earliest event in the step, located by bisection on the dense output
+        first = -1
+        lo, hi = 0.0, 1.0
+        for q in range(ng):
+            if g0[q] > 0.0 and g1[q] <= 0.0:
+                a, b, ga, gb = 0.0, 1.0, g0[q], g1[q]
+                if first >= 0:
+                    # only look before the earliest one found so far
+                    dense(r, hi, xe)
+                    event_values(t + hi * h, xe, nb, ns, strip_f, strip_i, spring_f, reg, dp,
+                                 dc0, tc0, fs, opt, delta, delta_dot, vt, pos, fe, fn, normal,
+                                 tang, theta_c, ge)
+                    if ge[q] > 0.0:
+                        continue
+                    b, gb = hi, ge[q]
+                # Illinois (regula falsi with halving of the stale end's value)
+                side = 0
+                for _ in range(100):
+                    if (b - a) * h < 1e-12:
+                        break
+                    mid = (a * gb - b * ga) / (gb - ga)
+                    # stay strictly inside, and bisect when the secant hugs an end
+                    if not (a + 0.01 * (b - a) < mid < b - 0.01 * (b - a)):
+                        mid = min(max(mid, a + 0.01 * (b - a)), b - 0.01 * (b - a))
+                    dense(r, mid, xe)
+                    event_values(t + mid * h, xe, nb, ns, strip_f, strip_i, spring_f, reg, dp,
+                                 dc0, tc0, fs, opt, delta, delta_dot, vt, pos, fe, fn, normal,
+                                 tang, theta_c, ge)
+                    gm = ge[q]
+                    if gm > 0.0:
+                        a, ga = mid, gm
+                        if side == 1:
+                            gb *= 0.5
+                        side = 1
+                    else:
+                        b, gb = mid, gm
+                        if side == -1:
+                            ga *= 0.5
+                        side = -1
+                first, lo, hi = q, a, b
+        t_new = t + h if first < 0 else t + hi * h
+        if first >= 0:
+            dense(r, hi, xe)
+            for m in range(nx):
+                x1[m] = xe[m]
+        # histories at the samples passed
+        while n_hist < n_samples and n_hist * dt_rec <= t_new + 1e-12 * dt_rec:
+            ts = n_hist * dt_rec
+            dense(r, min(1.0, max(0.0, (ts - t) / h)), xe)
+            kinematics(xe, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
+            contact_forces(xe, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp,
+                           fs, delta, delta_dot, vt, fe, fn, normal, tang)
+            for m in range(nx):
+                hist_x[n_hist, m] = xe[m]
+            for j in range(ns):
+                hist_n[n_hist, j] = normal[j]
+                hist_t[n_hist, j] = tang[j]
+            n_hist += 1
+        t = t_new
+        for m in range(nx):
+            x[m] = x1[m]
+        kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
+        contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs,
+                       delta, delta_dot, vt, fe, fn, normal, tang)
+        _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n)
+        if first >= 0:
+            kind, index = _transition(first, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg,
+                                      dp, dc0, tc0, fs, delta, normal, tang, acc)
+            n_ev = _log(n_ev, t, kind, index, ev_t, ev_kind, ev_index)
+            if kind >= EV_OVERTURN:
+                failure = kind
+                break
+            failure, n_ev = _settle(t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0,
+                                    tc0, fs, opt, delta, delta_dot, vt, pos, fe, fn, normal, tang,
+                                    theta_c, g0, acc, n_ev, ev_t, ev_kind, ev_index)
+            if failure != 0:
+                break
+            if n_ev > max_events:
+                failure = EV_STALL
+                break
+        rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
+            dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
+        event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
+                     delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
+        # step-size controller (elementary, order 5 solution with a 4th-order error estimate;
+        # Hairer's stabilised controller was tried: fewer rejections, as many evaluations)
+        h = h * min(5.0, max(0.2, 0.9 * max(err, 1e-10) ** -0.2))
+    # energy left in detached caps is not lost yet: count only what they have shed
+    for i in range(nsp):
+        if reg[i] == R_FREE and dc0[i] > dp[i]:
+            rem = cap_surface(spring_f[i, PF_K], spring_f[i, PF_C], dp[i], dc0[i], tc0[i], t) - dp[i]
+            acc[A_CAP_RELAX] -= 0.5 * spring_f[i, PF_K] * rem * rem
+            dc0[i] = dp[i] + rem
+            tc0[i] = t
+    return t, n_ev, failure, n_hist, n_acc, n_rej
+
+
+@njit(cache=True)
+def _log(n_ev, t, kind, index, ev_t, ev_kind, ev_index):
+    if n_ev < ev_t.shape[0]:
+        ev_t[n_ev] = t
+        ev_kind[n_ev] = kind
+        ev_index[n_ev] = index
+    return n_ev + 1
+
+
+@njit(cache=True)
+def _settle(t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
+            delta_dot, vt, pos, fe, fn, normal, tang, theta_c, gv, acc, n_ev, ev_t, ev_kind,
+            ev_index):
+    """Make the regimes consistent with the state after an event: while an event function is
+    negative (a strip that closes sliding, a spring closing on a cap it then pulls...), apply its
+    transition at the same instant. Returns (failure code or 0, events logged)."""
+    for _ in range(4 * (nsp + ns) + 8):
+        event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
+                     delta_dot, vt, pos, fe, fn, normal, tang, theta_c, gv)
+        q = -1
+        for m in range(gv.shape[0]):
+            if gv[m] < 0.0:
+                q = m
+                break
+        if q < 0:
+            return 0, n_ev
+        kind, index = _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0,
+                                  tc0, fs, delta, normal, tang, acc)
+        n_ev = _log(n_ev, t, kind, index, ev_t, ev_kind, ev_index)
+        if kind >= EV_OVERTURN:
+            return kind, n_ev
+    return EV_STALL, n_ev
+
+
+@njit(cache=True)
+def _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n):
+    for i in range(nsp):
+        peak_fe[i] = max(peak_fe[i], fe[i])
+        peak_fn[i] = max(peak_fn[i], fn[i])
+    for j in range(ns):
+        peak_n[j] = max(peak_n[j], normal[j])
+        if normal[j] > 0.0:
+            peak_util[j] = max(peak_util[j], abs(tang[j]) / normal[j])
+
+
+@njit(cache=True)
+def _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, delta,
+                normal, tang, acc):
+    """Apply event ``q`` at time t (state x just past it); returns (event kind, index)."""
+    o_u = 6 * nb
+    if q < 2 * nsp:
+        i = q // 2
+        k, c, fy = spring_f[i, PF_K], spring_f[i, PF_C], spring_f[i, PF_FY]
+        j = _strip_of(i, strip_i)
+        if reg[i] == R_FREE:
+            # the body meets the (relaxing) cap: elastic energy of the cap carries on
+            rem = cap_surface(k, c, dp[i], dc0[i], tc0[i], t) - dp[i]
+            acc[A_CAP_RELAX] -= 0.5 * k * rem * rem
+            reg[i] = R_ELASTIC
+            if fs[j] == F_FREE:
+                fs[j] = F_STICK
+                x[o_u + j] = 0.0
+            return EV_CLOSE, i
+        if reg[i] == R_ELASTIC and q % 2 == 0:
+            # the dashpot would pull: the cap lets go and relaxes on its own
+            reg[i] = R_FREE
+            dc0[i] = max(delta[i], dp[i])
+            tc0[i] = t
+            rem = dc0[i] - dp[i]
+            acc[A_CAP_RELAX] += 0.5 * k * rem * rem
+            carrying = False
+            for m in range(strip_i[j, SI_FIRST], strip_i[j, SI_FIRST] + strip_i[j, SI_COUNT]):
+                if reg[m] != R_FREE:
+                    carrying = True
+            if not carrying:
+                if fs[j] == F_STICK:
+                    u = x[o_u + j]
+                    acc[A_FRIC_EVENT] += 0.5 * strip_f[j, SF_KT] * u * u
+                fs[j] = F_FREE
+                x[o_u + j] = 0.0
+            return EV_DETACH, i
+        if reg[i] == R_ELASTIC:
+            reg[i] = R_CRUSH
+            return EV_CRUSH, i
+        # crushing ends: the set is kept (a hair short of the yield force, so that rounding
+        # cannot restart the crushing at once)
+        reg[i] = R_ELASTIC
+        dp[i] = delta[i] - fy / k * (1.0 - 1e-12)
+        return EV_UNLOAD, i
+    if q < 2 * nsp + ns:
+        j = q - 2 * nsp
+        if fs[j] == F_STICK:
+            u = x[o_u + j]
+            acc[A_FRIC_EVENT] += 0.5 * strip_f[j, SF_KT] * u * u
+            # the face slips the way the stick force resisted
+            fs[j] = 1 if tang[j] < 0.0 else -1
+            x[o_u + j] = 0.0
+            return EV_SLIP, j
+        # stick again with the spring preloaded to the kinetic friction force, so that the force is
+        # continuous; its energy is booked against the friction loss (it is given back at the next
+        # slip onset, or stays stored)
+        # (a hair below it, so that with mu_s = mu_k rounding cannot slip it again at once)
+        u = fs[j] * strip_f[j, SF_MUK] * normal[j] * (1.0 - 1e-9) / strip_f[j, SF_KT]
+        acc[A_FRIC_EVENT] -= 0.5 * strip_f[j, SF_KT] * u * u
+        fs[j] = F_STICK
+        x[o_u + j] = u
+        return EV_STICK, j
+    o = 2 * nsp + ns
+    if q < o + nb - 1:
+        return EV_OVERTURN, q - o + 1
+    kinds = (EV_SLID_OFF, EV_TIP, EV_SEPARATION, EV_INVALID)
+    return kinds[q - o - nb + 1], -1
+
+
+@njit(cache=True, inline="always")
+def _strip_of(i, strip_i):
+    for j in range(strip_i.shape[0]):
+        if strip_i[j, SI_FIRST] <= i < strip_i[j, SI_FIRST] + strip_i[j, SI_COUNT]:
+            return j
+    return -1

@@ -1,0 +1,84 @@
+"""Parameters of the dock-section model: defaults, derived stiffness, range checks by key."""
+
+import math
+
+import pytest
+
+from shipblock.errors import ParameterError, ParameterTypeError
+from shipblock.section import NAVY_BLOCK, Block, BlockLine, Cap, DockSection, Ship, Wind
+from shipblock.section.model import assemble, lobatto
+from shipblock.units import INCH
+
+
+def ship(**kw):
+    base = dict(mass=4e5, roll_inertia=4e5 * 9.0, g_height=4.0, keel_half_width=0.6,
+                half_beam=6.0)
+    return Ship(**{**base, **kw})
+
+
+def side(offset, **kw):
+    return BlockLine(n_blocks=2, offset=offset, **kw)
+
+
+def test_navy_block_defaults_and_derived_stiffness():
+    b = NAVY_BLOCK
+    assert b.half_width == pytest.approx(24 * INCH) and b.length == pytest.approx(42 * INCH)
+    assert b.top.thickness == pytest.approx(6 * INCH)
+    # 330 long tons force
+    assert b.capacity == pytest.approx(330 * 1016.0469088 * 9.80665)
+    area = b.length * 2 * b.half_width
+    assert b.top.normal_stiffness(area) == pytest.approx(b.top.modulus * area / b.top.thickness)
+    assert Cap(stiffness=3e9).normal_stiffness(area) == 3e9
+    # concrete core and two oak caps
+    expected = area * ((48 - 12) * INCH * 2400 + 12 * INCH * 760)
+    assert b.block_mass == pytest.approx(expected)
+
+
+def test_line_stiffness_is_n_blocks_times_e_a_over_t():
+    sec = DockSection(ship(), BlockLine(n_blocks=3))
+    asm = assemble(sec)
+    b = NAVY_BLOCK
+    half = min(b.half_width, 0.6)
+    k = 3 * b.top.modulus * b.length * 2 * half / b.top.thickness
+    assert asm.spring_f[:sec.n_springs, 2].sum() == pytest.approx(k)
+
+
+@pytest.mark.parametrize("n", [2, 3, 5, 9])
+def test_lobatto_rule_integrates_to_degree_2n_minus_3(n):
+    x, w = lobatto(n)
+    assert x[0] == -1.0 and x[-1] == 1.0
+    for degree in range(0, 2 * n - 2):
+        exact = 0.0 if degree % 2 else 2.0 / (degree + 1)
+        assert sum(w * x**degree) == pytest.approx(exact, abs=1e-12)
+
+
+@pytest.mark.parametrize("make, key", [
+    (lambda: Cap(thickness=-1.0), "Cap.thickness"),
+    (lambda: Cap(modulus=0.0), "Cap.modulus"),
+    (lambda: Cap(stiffness=0.0), "Cap.stiffness"),
+    (lambda: Cap(mu_s=0.3, mu_k=0.4), "Cap.mu_k"),
+    (lambda: Block(capacity=0.0), "Block.capacity"),
+    (lambda: Block(top=Cap(thickness=0.7), bottom=Cap(thickness=0.6)), "caps thicker"),
+    (lambda: BlockLine(n_blocks=0), "BlockLine.n_blocks"),
+    (lambda: BlockLine(hull_slope=math.radians(60)), "cannot be cut"),
+    (lambda: ship(g_height=-0.5), "G below the keel"),
+    (lambda: ship(mass=float("nan")), "Ship.mass"),
+    (lambda: Wind(height=5.0), "Wind takes"),
+    (lambda: DockSection(ship(), BlockLine(), (side(6.5),)), "not under the hull"),
+    (lambda: DockSection(ship(), BlockLine(), (side(0.9),)), "not clear of the keel"),
+    (lambda: DockSection(ship(), BlockLine(), (side(3.0, hull_height=0.5),)), "gap of"),
+    (lambda: DockSection(ship(), BlockLine(offset=1.0)), "DockSection.keel"),
+    (lambda: DockSection(ship(), BlockLine(), n_springs=1), "DockSection.n_springs"),
+])
+def test_bad_values_are_refused_by_key(make, key):
+    with pytest.raises(ParameterError, match=key):
+        make()
+
+
+def test_wrong_types_are_type_errors():
+    with pytest.raises(ParameterTypeError, match="Cap.modulus"):
+        Cap(modulus="1e9")
+    with pytest.raises(ParameterTypeError, match="DockSection.sides"):
+        DockSection(ship(), BlockLine(), sides=[1])
+    with pytest.raises(ParameterTypeError, match="Block.top"):
+        Block(top=1.0)

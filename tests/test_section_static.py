@@ -1,0 +1,171 @@
+"""Static state of the dock section against the elastic hand calculation of docking practice.
+
+The hand calculation takes the ship as rigid on linear elastic supports: line stiffnesses
+``K = N E A / t`` (caps of a moving line in series), the keel line's rotational stiffness that
+of its caps (a continuous layer: ``K b^2 / 3``, in series top and bottom), the gravity term
+``-W h_G`` of the roll stiffness, and the trapezoidal (moment-area) pressure across a cap. It is
+a small-deflection theory, and the model's static state is nonlinear (rotations, lift-off): they
+agree to the order of the rotations (~1e-6 here), so the tolerances are 1e-4, far below what a
+sign or factor error in a load path would give.
+"""
+
+import numpy as np
+import pytest
+
+from shipblock.errors import ParameterError
+from shipblock.section import Block, BlockLine, Cap, DockSection, Ship, Wind
+from shipblock.section import _kernel as K
+from shipblock.section.model import assemble, static_state
+
+G = 9.80665
+
+
+def keel_only(e_g, n_springs=5, modulus=1e12, g_height=2.0):
+    cap = Cap(modulus=modulus, proportional_limit=1e9)
+    blk = Block(top=cap, bottom=cap)
+    ship = Ship(mass=3e5, roll_inertia=3e5 * 4.0, g_height=g_height, keel_half_width=2.0,
+                half_beam=5.0, g_offset=e_g)
+    return DockSection(ship, BlockLine(block=blk, n_blocks=2), n_springs=n_springs)
+
+
+def top_springs(asm, state, j=0):
+    a, n = asm.strip_i[j, K.SI_FIRST], asm.strip_i[j, K.SI_COUNT]
+    return asm.spring_f[a:a + n], state.spring_force[a:a + n]
+
+
+@pytest.mark.parametrize("e_g", [0.0, 0.05, -0.12])
+def test_keel_cap_pressure_is_the_trapezoid_inside_the_kern(e_g):
+    sec = keel_only(e_g)
+    asm = assemble(sec)
+    st = static_state(asm)
+    springs, force = top_springs(asm, st)
+    blk, n = sec.keel.block, sec.keel.n_blocks
+    w = sec.ship.mass * G
+    b = blk.half_width
+    area, inertia = blk.length * 2 * b, blk.length * (2 * b) ** 3 / 12
+    y = springs[:, K.PF_RY]
+    pressure = w / n / area + w / n * e_g * y / inertia  # per block, linear across the cap
+    expected = pressure * springs[:, K.PF_AREA] * n
+    np.testing.assert_allclose(force, expected, rtol=1e-4, atol=1e-4 * expected.max())
+    assert st.normal[0] == pytest.approx(w, rel=1e-9)
+
+
+def test_keel_cap_beyond_the_kern_lifts_off_in_a_triangle():
+    """G at half the half-width off the centre (beyond b/3): contact length 3 (b - e), peak
+    pressure 2 W / (3 L (b - e)) (the cracked-section formula), sampled by 15 springs."""
+    sec = keel_only(0.3, n_springs=15)
+    asm = assemble(sec)
+    st = static_state(asm)
+    springs, force = top_springs(asm, st)
+    blk, n = sec.keel.block, sec.keel.n_blocks
+    b, e = blk.half_width, 0.3
+    w = sec.ship.mass * G / n
+    y = springs[:, K.PF_RY]
+    p = force / n / springs[:, K.PF_AREA]
+    # the pressure is linear over the springs in contact and zero beyond
+    loaded = p > 0
+    slope, inter = np.polyfit(y[loaded], p[loaded], 1)
+    np.testing.assert_allclose(p[loaded], slope * y[loaded] + inter, rtol=1e-4,
+                               atol=1e-4 * p.max())
+    zero_at = -inter / slope
+    assert b - zero_at == pytest.approx(3 * (b - e), rel=2e-2)
+    assert slope * b + inter == pytest.approx(2 * w / (3 * blk.length * (b - e)), rel=2e-2)
+    # equilibrium exactly: the resultant and its moment
+    assert force.sum() == pytest.approx(sec.ship.mass * G, rel=1e-9)
+
+
+def hand_three_lines(sec):
+    """Line loads and roll of a ship on a keel line and a symmetric pair of fixed side lines
+    whose contacts all lie in the keel's plane (flat hull): vertical equilibrium and the
+    moment about the keel's centre with compatibility ``delta(y) = w - phi y`` (the keel line's
+    top settling also by its blocks' weight on the bottom caps)."""
+    ship, keel = sec.ship, sec.keel
+    s = sec.sides[1]
+    d = s.offset
+    kb = keel.block
+    b = min(kb.half_width, ship.keel_half_width)
+    k_top = keel.n_blocks * kb.top.modulus * kb.length * 2 * b / kb.top.thickness
+    k_bot = keel.n_blocks * kb.bottom.modulus * kb.length * 2 * kb.half_width / kb.bottom.thickness
+    k_keel = 1 / (1 / k_top + 1 / k_bot)
+    kr_keel = 1 / (3 / (k_top * b**2) + 3 / (k_bot * kb.half_width**2))
+    sb = s.block
+    k_side = s.n_blocks * sb.top.modulus * sb.length * 2 * sb.half_width / sb.top.thickness
+    w = ship.mass * G
+    fw, hw = (sec.wind.lateral_force, sec.wind.height) if sec.wind else (0.0, 0.0)
+    kr_side = k_side * sb.half_width**2 / 3  # each side cap's own moment-area stiffness
+    phi = -(w * ship.g_offset + fw * hw) / (kr_keel + 2 * (k_side * d**2 + kr_side)
+                                             - w * ship.g_height)
+    # the keel block's own weight settles its bottom cap: the keel's top sinks by that more
+    w_block = keel.n_blocks * kb.block_mass * G
+    pre = w_block / k_bot
+    sink = (w + k_keel * pre) / (k_keel + 2 * k_side)
+    return {"keel": k_keel * (sink - pre), "port": k_side * (sink + phi * d),
+            "starboard": k_side * (sink - phi * d), "phi": phi}
+
+
+def three_lines(e_g, wind=None):
+    soft = Cap(shear_ratio=1e-3)  # keel caps: no shear coupling of the block's tilt
+    keel = BlockLine(block=Block(top=soft, bottom=soft), n_blocks=4)
+    side_block = Block()
+    sides = (BlockLine(block=side_block, n_blocks=2, offset=-3.5, moving=False),
+             BlockLine(block=side_block, n_blocks=2, offset=3.5, moving=False))
+    ship = Ship(mass=6e5, roll_inertia=6e5 * 9.0, g_height=4.0, keel_half_width=0.8,
+                half_beam=6.0, g_offset=e_g)
+    return DockSection(ship, keel, sides, wind=wind)
+
+
+@pytest.mark.parametrize("e_g, wind", [
+    (0.0, None), (0.15, None), (-0.3, None), (0.0, Wind(height=8.0, force=2e5)),
+    (0.1, Wind(height=6.0, pressure=-800.0, area=300.0)),
+])
+def test_line_loads_with_side_blocks_and_wind_match_the_hand_calculation(e_g, wind):
+    sec = three_lines(e_g, wind)
+    asm = assemble(sec)
+    st = static_state(asm)
+    hand = hand_three_lines(sec)
+    top = [j for j in range(asm.n_strips) if asm.strip_top[j]]
+    loads = dict(zip(("keel", "port", "starboard"), st.normal[top], strict=True))
+    total = sum(hand[k] for k in ("keel", "port", "starboard"))
+    assert total == pytest.approx(sec.ship.mass * G, rel=1e-12)
+    for name, value in loads.items():
+        assert value == pytest.approx(hand[name], rel=1e-4, abs=1e-5 * total), name
+    phi = st.x[2]
+    assert phi == pytest.approx(hand["phi"], rel=2e-3, abs=1e-9)
+    if wind is not None:
+        # the supports carry the wind: the horizontal forces on the blocks from the hull (normal
+        # forces along the rotated hull normals, stick springs along the tangents) sum to it
+        c, s_ = np.cos(phi), np.sin(phi)
+        horizontal = 0.0
+        for j in top:
+            ny = c * asm.strip_f[j, K.SF_SNY] - s_ * asm.strip_f[j, K.SF_SNZ]
+            nz = s_ * asm.strip_f[j, K.SF_SNY] + c * asm.strip_f[j, K.SF_SNZ]
+            u = st.x[6 * asm.n_bodies + j]
+            horizontal += st.normal[j] * ny - asm.strip_f[j, K.SF_KT] * u * nz
+        assert horizontal == pytest.approx(wind.lateral_force, rel=1e-6)
+
+
+def test_a_ship_unstable_on_its_keel_alone_is_refused():
+    sec = keel_only(0.0, modulus=1e6, g_height=40.0)
+    with pytest.raises(ParameterError, match="no static solution|unstable"):
+        static_state(assemble(sec))
+
+
+def test_caps_crushing_at_rest_are_refused_naming_the_line():
+    weak = Cap(proportional_limit=1e4)
+    sec = DockSection(Ship(mass=6e5, roll_inertia=5e6, g_height=3.0, keel_half_width=0.8,
+                           half_beam=6.0), BlockLine(block=Block(top=weak), n_blocks=2))
+    with pytest.raises(ParameterError, match="DockSection.keel: the top caps would crush"):
+        static_state(assemble(sec))
+
+
+def test_a_side_line_that_would_slide_at_rest_is_refused():
+    """One side line under a sloped hull: the static state with the strips sticking needs more
+    friction than mu_s gives; the dock is refused naming the line, not started out of its cone."""
+    slick = Cap(mu_s=0.05, mu_k=0.05)
+    side = BlockLine(block=Block(top=slick, bottom=slick, half_height=24 * 0.0254 + 0.15),
+                     n_blocks=2, offset=3.5, hull_height=0.3, hull_slope=0.3)
+    ship = Ship(mass=6e5, roll_inertia=6e5 * 9.0, g_height=3.0, keel_half_width=0.8,
+                half_beam=6.0, g_offset=0.3)
+    sec = DockSection(ship, BlockLine(n_blocks=4), (side,))
+    with pytest.raises(ParameterError, match=r"DockSection.sides\[0\]: at rest its .* face needs"):
+        static_state(assemble(sec))
