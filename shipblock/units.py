@@ -21,6 +21,10 @@ STANDARD_GRAVITY = 9.80665
 #: One inch [m] (international inch, 1959).
 INCH = 0.0254
 
+#: One long ton force [N] (2240 lb x 0.45359237 kg/lb x standard gravity): block capacities in
+#: US Navy docking practice are stated in long tons.
+LONG_TON_FORCE = 2240.0 * 0.45359237 * STANDARD_GRAVITY
+
 #: Factors that convert an acceleration in the named unit to m/s^2.
 ACCELERATION_UNITS_TO_SI: dict[str, float] = {
     "m/s^2": 1.0,

@@ -76,7 +76,8 @@ def test_notice_names_the_part_and_its_measured_time():
     msg = compile_message("the solver", solver_seconds)
     assert "the solver" in msg and f"{solver_seconds:.2g} s" in msg and "minute" not in msg
     assert {what for _, what, _ in COMPILED_PARTS} == {"the solver", "the contact loads",
-                                                       "the intensity measures"}
+                                                       "the intensity measures",
+                                                       "the dock-section model"}
 
 
 def test_every_module_with_compiled_code_is_a_known_part():

@@ -36,6 +36,7 @@ from shipblock.bench.solver import (
     runs_per_second,
     throughput,
 )
+from shipblock.bench.section import section_speed
 from shipblock.bench.startup import cold_start, write_cold_start
 from shipblock.bench.targets import (
     CAMPAIGN_RUNS,
@@ -112,6 +113,14 @@ def run_benchmarks(quick=False, pyslammer=True, output=None, stream=None, campai
               f"{SPECTRUM_SAMPLES} samples (best of {spectrum['rounds']}; target "
               f"{TARGETS['spectrum_seconds']:g} s: "
               f"{verdict(spectrum['seconds'] <= TARGETS['spectrum_seconds'])})\n")
+    section = section_speed(repeats=2 if quick else 5)
+    results["section"] = section
+    out.write(f"dock section      : {1e3 * section['section_seconds_per_run']:.0f} ms of one core per"
+              f" run (40 s at 200 Hz, keel and two side lines, Navy blocks; "
+              f"{section['accepted_steps']} steps, {section['events']} events); rigid solver "
+              f"{1e3 * section['rigid_seconds_per_run']:.2f} ms on the same record (target "
+              f"{1e3 * TARGETS['section_seconds_per_run']:.0f} ms: "
+              f"{verdict(section['section_seconds_per_run'] <= TARGETS['section_seconds_per_run'])})\n")
     rock = throughput(rocking_system(), records, scale=0.3, min_seconds=window)
     rock["peak_rotation_error"] = rocking_accuracy(rocking_system(), records, 0.3)
     results["rocking"] = rock

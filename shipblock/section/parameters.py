@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 from shipblock.checks import flag, real, whole
 from shipblock.errors import ParameterError, ParameterTypeError
-from shipblock.units import INCH, STANDARD_GRAVITY
+from shipblock.units import INCH, LONG_TON_FORCE, STANDARD_GRAVITY
 
 __all__ = [
     "LONG_TON_FORCE",
@@ -41,8 +41,6 @@ __all__ = [
     "Wind",
 ]
 
-#: One long ton force [N] (2240 lb x 0.45359237 kg/lb x standard gravity).
-LONG_TON_FORCE = 2240.0 * 0.45359237 * STANDARD_GRAVITY
 #: Density of the concrete of a block [kg/m^3] (normal-weight concrete).
 CONCRETE_DENSITY = 2400.0
 #: Density of white oak at 12 % moisture content [kg/m^3] (specific gravity 0.68, Wood Handbook

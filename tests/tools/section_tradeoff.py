@@ -9,7 +9,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from bench_section import navy_dock, record
+from shipblock.bench.section import navy_dock, record
 
 from shipblock.section.simulate import simulate_section
 

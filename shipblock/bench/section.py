@@ -1,8 +1,8 @@
 """Benchmark of the dock-section solver (issue 29): a 40 s record at 200 Hz on a dock with a keel
 line and two moving side lines, Navy-block defaults; and the rigid solver on the same record.
 
-Run: ``python tests/tools/bench_section.py`` (prints JSON). Not a test: speed is measured here,
-to be wired into ``shipblock bench`` by the lead.
+Part of ``shipblock bench`` (target: 50 ms of one core per run); ``python -m
+shipblock.bench.section`` prints the JSON alone.
 """
 
 from __future__ import annotations
@@ -12,11 +12,11 @@ import time
 
 import numpy as np
 
-from shipblock import ShipBlockSystem, simulate
 from shipblock.section import NAVY_BLOCK, Block, BlockLine, DockSection, Ship
 from shipblock.section.simulate import simulate_section
-
-G = 9.80665
+from shipblock.solver import simulate
+from shipblock.system import ShipBlockSystem
+from shipblock.units import STANDARD_GRAVITY
 
 
 def navy_dock() -> DockSection:
@@ -38,11 +38,13 @@ def record(duration=40.0, dt=0.005, pga=0.4, seed=2014):
     f = np.fft.rfftfreq(t.size, dt)
     spec *= (f > 0.2) * (f < 12.0) / (1.0 + (f / 3.0) ** 2)
     acc = np.fft.irfft(spec, t.size) * np.exp(-((t - 12.0) / 6.0) ** 2)
-    h = pga * G * acc / np.max(np.abs(acc))
+    h = pga * STANDARD_GRAVITY * acc / np.max(np.abs(acc))
     return h, 0.3 * np.roll(h, 37), dt
 
 
-def bench(repeats=5) -> dict:
+def section_speed(repeats=5) -> dict:
+    """CPU time [s] per run of the section and rigid solvers on :func:`record` (best of
+    ``repeats``, compiled first), with the section run's step and event counts."""
     dock = navy_dock()
     h, v, dt = record()
     simulate_section(dock, h[:400], v[:400], dt)  # compile
@@ -74,4 +76,4 @@ def bench(repeats=5) -> dict:
 
 
 if __name__ == "__main__":
-    print(json.dumps(bench(), indent=1))
+    print(json.dumps(section_speed(), indent=1))
