@@ -411,6 +411,16 @@ def _fit_table(ds) -> str:
     return _table(header, rows)
 
 
+def _arrangements(ds) -> list[dict]:
+    """The swept values a figure is drawn at: the first of each parameter, then each other
+    value of each parameter with the rest at their first ([{}] without a sweep)."""
+    first = sweep_selection(ds)
+    combos = [first]
+    for dim in first:
+        combos += [{**first, dim: v} for v in ds[dim].values[1:]]
+    return combos
+
+
 def _fragility_section(ds) -> str:
     out = ["<h2>4. Fragility</h2>",
            "<p>Lognormal fragility curves, median and dispersion beta, with the bootstrap band "
@@ -420,10 +430,7 @@ def _fragility_section(ds) -> str:
         out.append("<p>What <code>shipblock run</code> said:</p><pre>"
                    + _e("\n".join(lines)) + "</pre>")
     sweep = sweep_selection(ds)
-    combos = [sweep]
-    for dim in sweep:  # each value of each swept parameter, the others at their first
-        combos += [{**sweep, dim: v} for v in ds[dim].values[1:]]
-    for combo in combos:
+    for combo in _arrangements(ds):
         out.append(_figure(plot_fragility(ds, sweep=combo).figure,
                            "fragility curves" + (f" at {sweep_text(combo)}" if combo else "")))
     for dim in sweep:
@@ -455,24 +462,28 @@ def _risk_section(ds) -> str:
                      value(_RISK, index), f"{1 / rate:.4g}" if rate > 0 else "-",
                      value("risk_probability", index),
                      f"{float(ds['risk_tail_fraction'].values[index]):.1%}"
-                     if "risk_tail_fraction" in ds else "-"])
+                     if "risk_tail_fraction" in ds and rate > 0 else "-"])
     header = ["limit state", *sweep, "annual rate [1/yr]", "return period [yr]",
               f"P({days:g} d) [-]", "from beyond the curve"]
     out = ["<h2>5. Risk over the docking period</h2>",
            f"<p>Each fitted fragility convolved with the site hazard curve; probability of at "
-           f"least one exceedance during {days:g} days in the dock (Poisson). In brackets: "
-           + (f"{float(ds[f'{_RISK}_lower'].attrs['confidence']):.0%} bootstrap band."
-              if banded else f"no band ({_e(ds.attrs.get('risk_band', ''))}).") + "</p>",
+           f"least one exceedance during {days:g} days in the dock (Poisson). "
+           + (f"In brackets: {float(ds[f'{_RISK}_lower'].attrs['confidence']):.0%} bootstrap "
+              "band." if banded else
+              f"No bootstrap band ({_e(ds.attrs.get('risk_band', ''))}).") + "</p>",
            "<pre>" + _e(risk_lines(ds)[0]) + "</pre>", _table(header, rows)]
-    selection = sweep_selection(ds)
-    axes = plot_risk(ds, sweep=selection)
-    fig = axes[0].figure
-    # the figure's title with the study, system and design, as the study figures have
-    fig.suptitle(_wrapped([*study_caption(ds, selection),
-                           f"risk over a docking period of {days:g} days"
-                           + (f", drawn at {sweep_text(selection)}" if selection else "")]),
-                 fontsize=8.5, x=0.01, ha="left")
-    out.append(_figure(fig, "hazard, fragilities and deaggregation"))
+    for selection in _arrangements(ds):
+        where = f" at {sweep_text(selection)}" if selection else ""
+        if not np.isfinite(ds[_RISK].sel(selection).values).any():
+            out.append(f"<p>No figure{_e(where)}: no limit state was fitted there.</p>")
+            continue
+        fig = plot_risk(ds, sweep=selection)[0].figure
+        # the figure's title with the study, system and design, as the study figures have
+        fig.suptitle(_wrapped([*study_caption(ds, selection),
+                               f"risk over a docking period of {days:g} days"
+                               + (f", drawn at {sweep_text(selection)}" if selection else "")]),
+                     fontsize=8.5, x=0.01, ha="left")
+        out.append(_figure(fig, "hazard, fragilities and deaggregation" + where))
     return "\n".join(out)
 
 

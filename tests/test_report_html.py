@@ -188,3 +188,34 @@ def test_a_study_matched_to_a_target_draws_its_own_spectra(tmp_path, match):
                 float(given.at(1.0)[0]), rel=1e-12)
     text = report_html(ds, spectra=spectra)
     assert len(_images(text)) >= 2 and "against the target" in text
+
+
+def test_a_swept_study_reports_each_arrangement(tmp_path):
+    """A [sweep]: the fit table and the risk table have a row per swept value, and there is a
+    fragility figure per value and the median against the swept parameter."""
+    path = write_pipeline(tmp_path, levels="levels_g = [0.2, 0.3, 0.4, 0.45, 0.5]",
+                          sweep="[sweep]\nmu_ship = [0.3, 0.35]\n")
+    ds = run_pipeline(path, progress=False)
+    risk = run_risk(tmp_path / "out" / "result.nc", PGA_CURVES, 90, site="Seattle WA",
+                    output=tmp_path / "risk.nc", band=False)
+    assert np.isfinite(risk["risk_annual_rate"].sel(limit_state="ship_slip")).any()
+    out = tmp_path / "report.html"
+    assert main(["-q", "report", str(tmp_path / "risk.nc"), "-o", str(out)]) == 0
+    text = out.read_text(encoding="utf-8")
+    for value in (0.3, 0.35):
+        sel = {"limit_state": "ship_slip", "mu_ship": value}
+        median = float(ds["median_g"].sel(sel))
+        assert (f"<tr><td>ship_slip</td><td>{value:g}</td><td>"
+                + (f"{median:.3g}" if np.isfinite(median) else "not fitted")) in text
+        rate = float(risk["risk_annual_rate"].sel(sel))
+        if np.isfinite(rate):
+            assert f"<tr><td>ship_slip</td><td>{value:g}</td><td>{rate:.3g}</td>" in text
+        assert f'alt="fragility curves at mu_ship = {value:g}"' in text
+        if np.isfinite(risk["risk_annual_rate"].sel(mu_ship=value)).any():
+            assert f'alt="hazard, fragilities and deaggregation at mu_ship = {value:g}"' in text
+        else:
+            assert f"No figure at mu_ship = {value:g}: no limit state was fitted there" in text
+    assert 'alt="median against mu_ship"' in text and "P(90 d) [-]" in text
+    # fragility x 2, median sweep, IDA, risk where a limit state was fitted
+    assert len(_images(text)) == 4 + int(np.isfinite(risk["risk_annual_rate"]).any("limit_state")
+                                         .sum())
