@@ -33,6 +33,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 import matplotlib
+import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
@@ -56,7 +57,7 @@ from shipblock.risk.study import risk_lines
 from shipblock.scaling import TargetSpectrum, spectrum_match
 from shipblock.units import STANDARD_GRAVITY
 
-__all__ = ["check_study", "record_spectra", "report_html", "write_report"]
+__all__ = ["check_study", "record_spectra", "report_html", "study_spectra", "write_report"]
 
 #: The risk variables ``shipblock risk`` adds to a result.
 _RISK = "risk_annual_rate"
@@ -111,8 +112,6 @@ def _wrapped(lines) -> str:
 
 def _figure(fig, alt: str) -> str:
     """A matplotlib figure as an embedded PNG (the figure is closed)."""
-    import matplotlib.pyplot as plt
-
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=110)
     plt.close(fig)
@@ -253,9 +252,27 @@ def _records_table(ds, spectra) -> str:
 
 
 # ------------------------------------------------------------------------------ spectra
-def _stored_spectra(ds) -> dict:
-    """The study's own match (``record_sa``, ``target_sa``): each record scaled to the target
-    as given, by the factor the study's scale factors imply at every level."""
+def study_spectra(ds: xr.Dataset) -> dict:
+    r"""The records' spectra against the target a study was scaled to, from the file.
+
+    The study stored each record's spectrum as processed (``record_sa``) and the target as
+    given (``target_sa``) on the matching periods. Each record is drawn scaled to the target as
+    given, by the factor the study's own scale factors imply at every level: for
+    ``match = "range"`` the least-squares factor in ln Sa, :math:`\ln f = rac1n \sum_i
+    \ln(S^*_i / S_i)`; for ``"anchor"``, :math:`f = S^*(T_1) / S(T_1)` (``record_im``), the
+    target interpolated in (ln T, ln Sa) as :class:`~shipblock.scaling.TargetSpectrum` does.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A study with ``[design.target_spectrum]`` (variables ``record_sa``, ``target_sa``,
+        ``spectrum_misfit``).
+
+    Returns
+    -------
+    dict
+        As :func:`record_spectra`.
+    """
     periods = ds["spectrum_period"].values
     target = ds["target_sa"].values
     t1 = float(ds.attrs.get("im_period", np.nan))
@@ -341,8 +358,6 @@ def record_spectra(ds: xr.Dataset, target: TargetSpectrum, period_range=None) ->
 
 
 def _spectra_figure(ds, spectra):
-    import matplotlib.pyplot as plt
-
     fig, ax = plt.subplots(figsize=(9.0, 5.0), constrained_layout=True)
     periods = spectra["periods"]
     scaled = []
@@ -609,7 +624,7 @@ def write_report(results, output, *, hazard_results=None, target: TargetSpectrum
     if target is not None:
         spectra = record_spectra(ds, target, period_range)
     elif "record_sa" in ds:
-        spectra = _stored_spectra(ds)
+        spectra = study_spectra(ds)
     output = Path(output)
     output.parent.mkdir(parents=True, exist_ok=True)
     csv = write_csv(ds, output.with_name(output.stem + "_csv"))

@@ -17,7 +17,7 @@ import xarray as xr
 from shipblock.cli import main
 from shipblock.fragility.export import fragility_table
 from shipblock.fragility.pipeline import run_pipeline
-from shipblock.report_html import _stored_spectra, record_spectra, report_html
+from shipblock.report_html import record_spectra, report_html, study_spectra
 from shipblock.risk import run_risk
 from shipblock.scaling import read_target_spectrum
 
@@ -176,7 +176,7 @@ def test_a_study_matched_to_a_target_draws_its_own_spectra(tmp_path, match):
               '[design.target_spectrum]\nfile = "target.csv"\nunits = "g"\n'
               f'period_range = [0.2, 2.0]\nmatch = "{match}"\n')
     ds = run_pipeline(write_pipeline(tmp_path, kind="msa", levels=levels), progress=False)
-    spectra = _stored_spectra(ds)
+    spectra = study_spectra(ds)
     target = ds["target_sa"].values
     given = read_target_spectrum(tmp_path / "target.csv", "g")
     for i, m in enumerate(spectra["matches"].values()):
