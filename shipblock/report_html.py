@@ -321,12 +321,23 @@ def record_spectra(ds: xr.Dataset, target: TargetSpectrum, period_range=None) ->
     dict
         ``periods`` [s], ``target`` [m/s^2], ``matches`` (record id -> ``{"factor", "sa",
         "misfit"}``, or the reason it could not be read), ``source`` and ``how``.
+
+    Raises
+    ------
+    ParameterError
+        If ``period_range`` is not two increasing positive periods.
+    TargetSpectrumError
+        If the target does not cover ``period_range`` (naming the target's file and range).
     """
     # the records' stack (obspy) is needed only here
     from shipblock.processing import process_motion
     from shipblock.records.catalogue import load_catalogue
 
     lo, hi = period_range if period_range is not None else (target.periods[0], target.periods[-1])
+    if not 0 < lo < hi:
+        raise ParameterError(f"period_range must be (T_a, T_b) with 0 < T_a < T_b [s], got "
+                             f"({lo:g}, {hi:g})")
+    target.at([lo, hi])  # a range beyond the target's is refused before any record is read
     document = _pipeline_document(ds)
     records = document.get("records", {})
     kwargs = {"response": records["response"]} if "response" in records else {}

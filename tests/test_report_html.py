@@ -140,7 +140,7 @@ def test_not_a_study_is_refused_by_name(tmp_path, capsys):
     assert not (tmp_path / "r.html").exists()
 
 
-def test_records_against_a_given_target_are_least_squares_in_ln_sa(demo, tmp_path):
+def test_records_against_a_given_target_are_least_squares_in_ln_sa(demo, tmp_path, capsys):
     """``--target``: each record read and processed again, scaled by its least-squares factor
     in ln Sa over the range (the log residuals average zero) and its misfit their RMS."""
     (tmp_path / "uhs.csv").write_text("period [s], Sa [g]\n0.05, 0.6\n0.2, 1.2\n0.6, 1.1\n"
@@ -164,6 +164,11 @@ def test_records_against_a_given_target_are_least_squares_in_ln_sa(demo, tmp_pat
         assert re.search(rf"<td>{re.escape(rid)}</td>.*?<td>{m['misfit']:.3g}</td><td>yes</td>",
                          text), rid
     assert len(_images(text)) == 3
+    # a range the target does not cover is refused before a record is read, naming the file
+    assert main(["-q", "report", str(demo), "--target", str(tmp_path / "uhs.csv"),
+                 "--period-range", "0.01", "2.0", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "uhs.csv: the target spectrum covers 0.05 to 4 s; periods 0.01 to 2 s are needed" in err
 
 
 @pytest.mark.parametrize("match", ["range", "anchor"])
