@@ -1,5 +1,5 @@
 """The ``shipblock`` command: simulate, process, info, catalogue, run, history, plot, export, risk,
-select, bench.
+select, report, bench.
 
 The command only parses arguments, calls the library and prints; every computation lives in the
 library. User errors print one line ``shipblock: error: ...`` and exit with status 2.
@@ -703,6 +703,19 @@ def cmd_export(args):
     return 0
 
 
+def cmd_report(args):
+    from shipblock.report_html import write_report
+    from shipblock.risk.selection import target_from_file
+
+    target = None if args.target is None else target_from_file(args.target, args.units)
+    written = write_report(args.results, args.output, hazard_results=args.hazard_results,
+                           target=target, period_range=args.period_range)
+    sys.stdout.write(f"report written to {written[0]}\n")
+    for path in written[1:]:
+        sys.stdout.write(f"written {path}\n")
+    return 0
+
+
 def cmd_bench(args):
     if args.read:
         import json
@@ -906,6 +919,29 @@ def build_parser():
     s.add_argument("results", help="NetCDF written by 'run'")
     s.add_argument("--csv", required=True, metavar="DIR", help="folder for the CSV tables")
     s.set_defaults(func=cmd_export)
+
+    s = sub.add_parser("report", help="a study's report: one HTML file with its figures, and CSV "
+                                      "tables",
+                       description="Write a self-contained HTML report of a results file of "
+                       "'shipblock run': the study (pipeline, design, system with units, "
+                       "processing, solver options), the records used and left out, their "
+                       "spectra against a target spectrum, the limit states, the fragility "
+                       "curves with bootstrap bands and, with a file of 'shipblock risk', the "
+                       "risk over the docking period; figures embedded as PNG; the tables of "
+                       "'shipblock export' in <output stem>_csv/ beside it.")
+    s.add_argument("results", help="NetCDF written by 'run' (or by 'risk')")
+    s.add_argument("--hazard-results", metavar="FILE",
+                   help="NetCDF written by 'shipblock risk' for this study: its risk goes in")
+    s.add_argument("--target", metavar="FILE",
+                   help="target spectrum to draw the records' spectra against (two columns, "
+                        "period [s] and Sa; default: the study's own target, if any); the "
+                        "records are read and processed again")
+    s.add_argument("--units", help="unit of the target's Sa (default: from its header)")
+    s.add_argument("--period-range", nargs=2, type=float, metavar=("TA", "TB"),
+                   help="periods of the match with --target [s] (default: the target's)")
+    s.add_argument("--output", "-o", default="report.html", help="HTML file to write "
+                                                                  "(default report.html)")
+    s.set_defaults(func=cmd_report)
 
     s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "
                                      "batch scaling")
