@@ -57,7 +57,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from shipblock.errors import ParameterTypeError, ShipblockError
+from shipblock import checks
+from shipblock.errors import ParameterTypeError, ShipblockError, TomlNestingError
 from shipblock.fragility.design import (
     IM_LEVEL_RANGE,
     IM_MEASURES,
@@ -291,13 +292,25 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
 
     Raises
     ------
+    ParameterTypeError
+        Naming the argument, if ``text`` is not a ``str`` (``None``, bytes, a path: use
+        :func:`load_pipeline` for a file), ``base`` not a path or ``source`` not a string.
     PipelineError
         Naming the key: unknown key, wrong type, missing section or key, invalid value,
-        unknown record id, invalid system, limit state or design.
+        unknown record id, invalid system, limit state or design; a name (limit state,
+        record id) or file name with a control character; nesting deeper than
+        :data:`shipblock.checks.MAX_TOML_DEPTH` levels.
     """
-    base = Path(base)
+    source = checks.text(source, "source", what="a name for the pipeline in messages")
+    if not isinstance(text, str):
+        raise ParameterTypeError(f"text must be the pipeline's TOML text (a str; "
+                                 f"load_pipeline reads a file), got {type(text).__name__} "
+                                 f"{text!r:.80}")
+    base = Path(checks.pathname(base, "base", "the folder of the pipeline's relative paths"))
     try:
-        doc = tomllib.loads(text)
+        doc = checks.toml_document(text)
+    except TomlNestingError as exc:
+        raise PipelineError("", exc.problem, source) from None
     except tomllib.TOMLDecodeError as exc:
         raise PipelineError("", f"is not valid TOML: {exc}", source) from exc
     check_table(doc, "", source)

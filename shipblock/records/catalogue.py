@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from shipblock import checks
-from shipblock.errors import ParameterError, ParameterTypeError, RecordError
+from shipblock.errors import ParameterError, ParameterTypeError, RecordError, TomlNestingError
 from shipblock.records.folders import MotionSet
 from shipblock.records.motion import COMPONENTS, GroundMotion
 from shipblock.records.reading import read_motion
@@ -224,12 +224,14 @@ def load_catalogue(path=None) -> dict[str, CatalogueEntry]:
                                      " file; 'shipblock catalogue FOLDER' writes one)")
     try:
         with open(catalogue, "rb") as fh:
-            document = tomllib.load(fh)
+            document = checks.toml_document(fh.read().decode("utf-8"))
     except FileNotFoundError:
         raise RecordError(catalogue, "catalogue file not found (path must name a catalogue TOML"
                                      " file)") from None
     except OSError as exc:
         raise RecordError(catalogue, f"cannot be read: {exc}") from exc
+    except TomlNestingError as exc:
+        raise RecordError(catalogue, exc.problem) from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise RecordError(catalogue, f"is not valid TOML: {exc}") from exc
     version = document.get("schema_version", SCHEMA_VERSION)
