@@ -29,6 +29,7 @@ take is refused with the closest one it does (:func:`keywords`).
 from __future__ import annotations
 
 import difflib
+import inspect
 import math
 import os
 import re
@@ -63,6 +64,7 @@ __all__ = [
     "flag",
     "closest",
     "is_real",
+    "keyword_names",
     "keywords",
     "label",
     "pathname",
@@ -486,22 +488,42 @@ def closest(word, choices: Iterable[str]) -> str:
     return f"; did you mean {found[0]!r}?" if found else ""
 
 
-def keywords(given: Mapping, accepted: Collection[str], function: str) -> None:
+def keyword_names(function, skip: int = 0) -> list[str]:
+    """The names ``function`` takes as keyword arguments (its first ``skip`` left out)."""
+    parameters = list(inspect.signature(function).parameters.values())[skip:]
+    return [p.name for p in parameters if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+
+
+def keywords(given: Mapping, accepted: Collection[str], function: str,
+             listed: Collection[str] | None = None, others: str = "") -> None:
     """Refuse a keyword argument that ``function`` does not take, suggesting the closest.
 
     For functions that pass ``**kwargs`` on: a misspelt keyword (``unit=`` for ``units=``)
     would otherwise be ignored.
 
+    Parameters
+    ----------
+    given : mapping
+        The keyword arguments.
+    accepted : collection of str
+        Every keyword ``function`` takes.
+    function : str
+        Its name, for the message.
+    listed : collection of str, optional
+        The keywords the message lists (default: ``accepted``); ``others`` says what else is
+        accepted (``"a reader's keyword"``).
+
     Raises
     ------
     ParameterTypeError
-        Naming the first unknown keyword, the closest accepted one and all accepted ones.
+        Naming the first unknown keyword, the closest accepted one and the accepted ones.
     """
+    shown = ", ".join(sorted(accepted if listed is None else listed))
     for key in given:
         if key not in accepted:
             raise ParameterTypeError(
                 f"{function}() got an unknown keyword argument {key!r}{closest(key, accepted)}"
-                f" (accepted: {', '.join(sorted(accepted))})")
+                f" (accepted: {shown}{f'; or {others}' if others else ''})")
 
 
 #: The tokens of TOML that can hold brackets without nesting anything, strings (multi-line

@@ -153,6 +153,10 @@ def _entry(table: dict, base: Path, catalogue: Path) -> CatalogueEntry:
                                          f" {table[key]!r}")
     if not table["id"].strip():
         raise RecordError(catalogue, "a record's id is empty: id must be a non-empty string")
+    try:
+        checks.label(table["id"], "id", what="a record id")
+    except ParameterError as exc:
+        raise RecordError(catalogue, f"record {entry_id!r}: {exc}") from None
     files = table["files"]
     if isinstance(files, str):
         files = [files]
