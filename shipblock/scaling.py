@@ -438,7 +438,8 @@ def scale_motion(motion, **options):
         Input motion [m/s^2]; unchanged.
     **options
         Keyword arguments of :func:`scale_record` (``target``, ``factor``, ``measure``,
-        ``period``, ``damping``, ``vertical_mode``, ..., ``reverse``).
+        ``period``, ``damping``, ``vertical_mode``, ..., ``reverse``); another keyword is a
+        :class:`~shipblock.errors.ParameterTypeError` naming it and the closest one.
 
     Returns
     -------
@@ -452,6 +453,7 @@ def scale_motion(motion, **options):
     from shipblock.records.motion import COMPONENT_KEY, check_motion
 
     check_motion(motion)
+    checks.keywords(options, checks.keyword_names(scale_record, 3), "scale_motion")
     result = scale_record(motion.horizontal, motion.vertical, motion.dt, **options)
     args = ", ".join(f"{k}={v!r}" for k, v in sorted(options.items()))
     entry = (

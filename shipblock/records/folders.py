@@ -209,7 +209,7 @@ def _label(key: tuple) -> str:
 
 def read_motions(source, inventory=None, units: str | None = None, *,
                  response: str = "sensitivity", differentiate: bool = False,
-                 align: str = "trim", gaps: str = "refuse", event=None) -> MotionSet:
+                 align: str = "trim", gaps: str = "refuse", event=None, **unknown) -> MotionSet:
     """Read a folder, glob or list of record files into one ground motion per station sensor.
 
     Parameters
@@ -224,6 +224,8 @@ def read_motions(source, inventory=None, units: str | None = None, *,
         As in :func:`~shipblock.records.reading.read_motion`.
     event : optional
         QuakeML file or object; default: a QuakeML file among the sources, if there is one.
+    **unknown
+        None is taken: a keyword not named above (``unit=``) is refused, naming the closest.
 
     Returns
     -------
@@ -237,10 +239,13 @@ def read_motions(source, inventory=None, units: str | None = None, *,
         :func:`~shipblock.records.reading.read_motion`: ``units="furlongs"``,
         ``response="partial"``...);
         a wrong option is not a failure of every record.
+    ParameterTypeError
+        For an unknown keyword, naming the closest (``unit``: did you mean ``units``?).
     RecordError
         If the source names nothing, or an inventory or event path names no file; a folder in
         which no file is readable gives an empty set with every failure listed, not an error.
     """
+    checks.keywords(unknown, checks.keyword_names(read_motions), "read_motions")
     options = check_read_arguments(inventory=inventory, units=units, response=response,
                                    differentiate=differentiate, align=align, gaps=gaps,
                                    event=event)

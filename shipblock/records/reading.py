@@ -32,6 +32,7 @@ from obspy import Stream, Trace
 
 from shipblock import checks
 from shipblock.errors import ParameterError, ParameterTypeError, RecordError
+from shipblock.io import check_reader_keywords
 from shipblock.records.arguments import check_channel_map, check_read_arguments
 from shipblock.records.assembly import assemble_motion, load_stream
 from shipblock.records.folders import read_motions
@@ -173,7 +174,9 @@ def read_motion(
         channel code (``"HN"``), optionally after the location (``"02.HN"``; K-NET/KiK-net:
         ``"01"`` is the borehole, ``"02"`` the surface sensor).
     **read_kwargs
-        Passed to the file reader (e.g. ``dt`` [s] for one-column text files).
+        Passed to the file reader (e.g. ``dt`` [s] for one-column text files): a keyword of
+        :func:`obspy.read` or of a format's reader (:func:`shipblock.io.read_record`). Any
+        other is refused before a file is read (``unit="g"``: did you mean ``units``?).
 
     Returns
     -------
@@ -185,7 +188,8 @@ def read_motion(
     ParameterError
         Before any file is read, naming the argument and what it expects (a
         :class:`~shipblock.errors.ParameterTypeError`, also a :class:`TypeError`, for a wrong
-        type): a source that is not a path, list of paths, Stream or Trace; an unknown unit
+        type): a keyword that neither read_motion nor a reader takes, naming the closest
+        one; a source that is not a path, list of paths, Stream or Trace; an unknown unit
         (``units="furlongs"``), response, alignment, gap rule or format; an azimuth that is not a
         number within +-360 deg; a horizontal other than H1/H2, or both; a channel_map that is
         not a dict of components; ``differentiate`` not a bool; ``sensor`` not a string, or one
@@ -200,6 +204,7 @@ def read_motion(
     UnitsError
         If the units of a trace are unknown or contradictory.
     """
+    check_reader_keywords(read_kwargs, "read_motion", checks.keyword_names(read_motion))
     options = check_read_arguments(inventory=inventory, units=units, response=response,
                                    differentiate=differentiate, align=align, gaps=gaps,
                                    event=event, format=format)
