@@ -556,11 +556,13 @@ def read_target_spectrum(path, units) -> TargetSpectrum:
 
     Raises
     ------
+    ParameterTypeError
+        If ``path`` is not a path (``None``, bytes, a number).
     TargetSpectrumError
         Naming the file and line: missing file, a line that is not two numbers, periods not
         increasing, non-positive values, an unknown unit.
     """
-    path = Path(path)
+    path = Path(checks.pathname(path, "path", "a target spectrum file (period [s], Sa)"))
     try:
         factor = float(acceleration_to_si(1.0, units))
     except ValueError as exc:

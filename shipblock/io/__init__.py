@@ -121,8 +121,9 @@ def reader_keywords() -> frozenset[str]:
     only for a keyword that is not one of obspy.read's or shipblock's readers'.
     """
     names = set(_OWN_READER_KEYWORDS)
+    installed = entry_points()  # one scan of the installed packages' metadata
     for name in ENTRY_POINTS.get("waveform", {}):
-        for point in entry_points(group=f"obspy.plugin.waveform.{name}", name="readFormat"):
+        for point in installed.select(group=f"obspy.plugin.waveform.{name}", name="readFormat"):
             try:
                 names.update(checks.keyword_names(point.load(), 1))
             except (ImportError, AttributeError):  # a broken plug-in has no keywords to offer
