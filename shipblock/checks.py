@@ -17,17 +17,28 @@ Paths are checked the same way: a value that is not a ``str`` or :class:`os.Path
 :class:`~shipblock.errors.ParameterTypeError` naming the argument (:func:`pathname`); a path that
 names no file, or a folder where a file is needed, is a :class:`~shipblock.errors.RecordError`
 that names the path and the argument (:func:`existing_file`).
+
+Names a user gives that become labels, coordinates or file names (limit states, record ids)
+hold printable characters only (:func:`label`): a NUL or another control character makes two
+names print alike, or look alike once a C library (netCDF, the file system) cuts them. A TOML
+document is read with :func:`toml_document`, which refuses nesting deeper than
+:data:`MAX_TOML_DEPTH` by name instead of a ``RecursionError``. A keyword a function does not
+take is refused with the closest one it does (:func:`keywords`).
 """
 
 from __future__ import annotations
 
+import difflib
+import inspect
 import math
 import os
-from collections.abc import Collection
+import re
+import tomllib
+from collections.abc import Collection, Iterable, Mapping
 
 import numpy as np
 
-from shipblock.errors import ParameterError, ParameterTypeError, RecordError
+from shipblock.errors import ParameterError, ParameterTypeError, RecordError, TomlNestingError
 from shipblock.units import (
     ACCELERATION_UNITS_TO_SI,
     STANDARD_GRAVITY,
@@ -43,6 +54,7 @@ __all__ = [
     "MAX_PADDING",
     "MAX_PERIOD",
     "MAX_TIME_STEP",
+    "MAX_TOML_DEPTH",
     "MIN_PERIOD",
     "MIN_TIME_STEP",
     "READ_OPTIONS",
@@ -51,12 +63,17 @@ __all__ = [
     "choice",
     "existing_file",
     "flag",
+    "closest",
     "how_to_pass",
     "is_real",
+    "keyword_names",
+    "keywords",
+    "label",
     "pathname",
     "real",
     "text",
     "time_step",
+    "toml_document",
     "unit",
     "whole",
 ]
@@ -84,6 +101,11 @@ MAX_PADDING = 600.0
 #: Largest magnitude of an azimuth accepted [deg] (one turn either way; an azimuth of 1e300 deg
 #: is a corrupt number, not a direction).
 MAX_AZIMUTH = 360.0
+
+#: Deepest nesting of arrays and tables read from a TOML file [levels]. A pipeline or catalogue
+#: needs four; Python's TOML parser recurses once or twice a level and fails near 500
+#: (``RecursionError``), and so do the readers that walk the document.
+MAX_TOML_DEPTH = 32
 
 _REAL_TYPES = (int, float, np.integer, np.floating)
 
@@ -495,3 +517,139 @@ def how_to_pass(keyword: str, value, placeholder: bool = False) -> str:
         return f"pass {flag} {value} (catalogue key {key} = {value}; Python {keyword}={value})"
     toml = f'"{value}"' if isinstance(value, str) else f"{value!r}"
     return f"pass {flag} {value} (catalogue key {key} = {toml}; Python {keyword}={value!r})"
+def label(value, name: str, *, what: str = "a name") -> str:
+    """``value`` checked to be a non-empty string of printable characters.
+
+    For names that become labels, coordinates or file names. Printable is Python's
+    :meth:`str.isprintable`: no control characters (Unicode category Cc: NUL, tab, newline,
+    escape, DEL, the C1 controls), format characters (Cf: zero-width and direction marks),
+    line or paragraph separators, surrogates, private-use or unassigned code points, and no
+    space but the ASCII one. Such a character makes two names print alike, or alike once a C
+    library (netCDF, the file system) cuts the name at a NUL.
+
+    Raises
+    ------
+    ParameterTypeError
+        Naming ``name``, if ``value`` is not a string.
+    ParameterError
+        Naming ``name``, the character (``U+0000``) and its position, if it is empty or holds a
+        character that is not printable.
+    """
+    text(value, name, what=what)
+    bad = next((i for i, ch in enumerate(value) if not ch.isprintable()), None)
+    if bad is not None:
+        raise ParameterError(f"{name} must be {what} of printable characters, got {value!r} "
+                             f"(U+{ord(value[bad]):04X} at position {bad}: a control or "
+                             "other non-printable character)")
+    return value
+
+
+def closest(word, choices: Iterable[str]) -> str:
+    """``"; did you mean 'x'?"`` for the choice most like ``word`` (:mod:`difflib`), or ``""``."""
+    found = difflib.get_close_matches(str(word), list(choices), n=1)
+    return f"; did you mean {found[0]!r}?" if found else ""
+
+
+def keyword_names(function, skip: int = 0) -> list[str]:
+    """The names ``function`` takes as keyword arguments (its first ``skip`` left out)."""
+    parameters = list(inspect.signature(function).parameters.values())[skip:]
+    return [p.name for p in parameters if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+
+
+def keywords(given: Mapping, accepted: Collection[str], function: str,
+             listed: Collection[str] | None = None, others: str = "") -> None:
+    """Refuse a keyword argument that ``function`` does not take, suggesting the closest.
+
+    For functions that pass ``**kwargs`` on: a misspelt keyword (``unit=`` for ``units=``)
+    would otherwise be ignored.
+
+    Parameters
+    ----------
+    given : mapping
+        The keyword arguments.
+    accepted : collection of str
+        Every keyword ``function`` takes.
+    function : str
+        Its name, for the message.
+    listed : collection of str, optional
+        The keywords the message lists (default: ``accepted``); ``others`` says what else is
+        accepted (``"a reader's keyword"``).
+
+    Raises
+    ------
+    ParameterTypeError
+        Naming the first unknown keyword, the closest accepted one and the accepted ones.
+    """
+    shown = ", ".join(sorted(accepted if listed is None else listed))
+    for key in given:
+        if key not in accepted:
+            raise ParameterTypeError(
+                f"{function}() got an unknown keyword argument {key!r}{closest(key, accepted)}"
+                f" (accepted: {shown}{f'; or {others}' if others else ''})")
+
+
+#: The tokens of TOML that can hold brackets without nesting anything, strings (multi-line
+#: ones first, with the one or two quotes allowed before their closing delimiter) and
+#: comments, and the brackets themselves.
+_TOML_TOKENS = re.compile(r'''
+      """(?:[^"\\]|\\.|"(?!""))*"{3,5}
+    | \'\'\'.*?\'{3,5}
+    | "(?:[^"\\\n]|\\.)*"
+    | '[^'\n]*'
+    | \#[^\n]*
+    | [\[\]{}]
+''', re.VERBOSE | re.DOTALL)
+
+
+def _too_deep(where: str) -> TomlNestingError:
+    where = where if len(where) <= 80 else where[:77] + "..."
+    return TomlNestingError(f"is nested deeper than {MAX_TOML_DEPTH} levels of arrays and "
+                            f"tables ({where}); shipblock reads at most {MAX_TOML_DEPTH}")
+
+
+def toml_document(source: str) -> dict:
+    """Parse TOML text (:func:`tomllib.loads`), refusing nesting deeper than :data:`MAX_TOML_DEPTH`.
+
+    The brackets of inline arrays and tables are counted before parsing (outside strings and
+    comments), since the parser recurses on them; the parsed document is then measured
+    without recursion, since dotted keys and table headers nest too (``a.b.c = 1`` is three
+    levels).
+
+    Parameters
+    ----------
+    source : str
+        The TOML document.
+
+    Returns
+    -------
+    dict
+        The document.
+
+    Raises
+    ------
+    TomlNestingError
+        Saying how deep and where (the line, or the key); the caller names the file.
+    tomllib.TOMLDecodeError
+        If the text is not TOML.
+    """
+    depth = 0
+    for token in _TOML_TOKENS.finditer(source):
+        bracket = token.group()
+        if bracket in ("[", "{"):
+            depth += 1
+            if depth > MAX_TOML_DEPTH:
+                raise _too_deep(f"line {source.count(chr(10), 0, token.start()) + 1}")
+        elif bracket in ("]", "}"):
+            depth = max(depth - 1, 0)
+    document = tomllib.loads(source)
+    stack = [(document, 0, "")]
+    while stack:
+        node, level, where = stack.pop()
+        if level > MAX_TOML_DEPTH:
+            raise _too_deep(f"at {where}")
+        for key, child in (node.items() if isinstance(node, dict) else enumerate(node)):
+            if isinstance(child, dict | list):
+                inner = (f"{where}[{key}]" if isinstance(key, int)
+                         else f"{where}.{key}" if where else str(key))
+                stack.append((child, level + 1, inner))
+    return document

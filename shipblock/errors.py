@@ -8,7 +8,8 @@ input data.
 
 from __future__ import annotations
 
-__all__ = ["ParameterError", "ParameterTypeError", "RecordError", "ShipblockError", "UnitsError"]
+__all__ = ["ParameterError", "ParameterTypeError", "RecordError", "ShipblockError", "TomlNestingError",
+           "UnitsError"]
 
 
 class ShipblockError(Exception):
@@ -25,6 +26,28 @@ class ParameterTypeError(ParameterError, TypeError):
     Also a :class:`TypeError`, the type Python code conventionally raises for it; the message
     names the parameter and what it expects.
     """
+
+
+class TomlNestingError(ParameterError):
+    """A TOML document nests arrays and tables deeper than shipblock reads.
+
+    Raised by :func:`shipblock.checks.toml_document` before the parser recurses that deep (a
+    ``RecursionError`` otherwise); each reader of a TOML file turns it into its own error naming
+    the file.
+
+    Parameters
+    ----------
+    problem : str
+        What is wrong and where (the line), without the file name.
+    """
+
+    def __init__(self, problem: str):
+        self.problem = problem
+        super().__init__(problem)
+
+    def __reduce__(self):
+        """Keep the error picklable."""
+        return (type(self), (self.problem,))
 
 
 class RecordError(ShipblockError, ValueError):

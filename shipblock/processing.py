@@ -131,7 +131,8 @@ def _bind(name: str, signature: inspect.Signature, params: Mapping) -> dict:
     for key in params:
         if key not in names:
             known = ", ".join(sorted(names)) or "none"
-            raise ProcessingError(name, f"unknown parameter (accepted: {known})", str(key))
+            raise ProcessingError(name, f"unknown parameter{checks.closest(key, names)} "
+                                        f"(accepted: {known})", str(key))
     bound = {}
     for p in accepted:
         if p.name in params:

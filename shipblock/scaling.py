@@ -483,7 +483,8 @@ def scale_motion(motion, **options):
         Input motion [m/s^2]; unchanged.
     **options
         Keyword arguments of :func:`scale_record` (``target``, ``factor``, ``measure``,
-        ``period``, ``damping``, ``vertical_mode``, ..., ``reverse``).
+        ``period``, ``damping``, ``vertical_mode``, ..., ``reverse``); another keyword is a
+        :class:`~shipblock.errors.ParameterTypeError` naming it and the closest one.
 
     Returns
     -------
@@ -505,6 +506,7 @@ def scale_motion(motion, **options):
     from shipblock.records.motion import COMPONENT_KEY, check_motion
 
     check_motion(motion)
+    checks.keywords(options, checks.keyword_names(scale_record, 3), "scale_motion")
     result = scale_record(motion.horizontal, motion.vertical, motion.dt, **options)
     args = ", ".join(f"{k}={v!r}" for k, v in sorted(options.items()))
     entry = (
@@ -607,11 +609,13 @@ def read_target_spectrum(path, units) -> TargetSpectrum:
 
     Raises
     ------
+    ParameterTypeError
+        If ``path`` is not a path (``None``, bytes, a number).
     TargetSpectrumError
         Naming the file and line: missing file, a line that is not two numbers, periods not
         increasing, non-positive values, an unknown unit.
     """
-    path = Path(path)
+    path = Path(checks.pathname(path, "path", "a target spectrum file (period [s], Sa)"))
     try:
         factor = float(acceleration_to_si(1.0, units))
     except ValueError as exc:

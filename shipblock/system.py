@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import logging
 import math
+import tomllib
 from dataclasses import asdict, dataclass
 from functools import cached_property
 
 import numpy as np
 
-from shipblock.checks import choice, real, whole
-from shipblock.errors import ParameterError, ParameterTypeError
+from shipblock.checks import choice, pathname, real, toml_document, whole
+from shipblock.errors import ParameterError, ParameterTypeError, TomlNestingError
 from shipblock.quantities import to_si
 from shipblock.units import STANDARD_GRAVITY
 
@@ -344,16 +345,26 @@ class ShipBlockSystem:
     @classmethod
     def from_toml(cls, path) -> ShipBlockSystem:
         """Read a system from a TOML file with a ``[system]`` table: numbers in SI units, or
-        strings with a unit (``ship_mass = "20000 t"``, ``half_width = "600 mm"``)."""
-        import tomllib
+        strings with a unit (``ship_mass = "20000 t"``, ``half_width = "600 mm"``).
 
+        Raises
+        ------
+        ParameterTypeError
+            If ``path`` is not a path (``None``, a number: never a file descriptor).
+        ParameterError
+            Naming the file: unreadable, not UTF-8, not TOML, nested deeper than
+            :data:`shipblock.checks.MAX_TOML_DEPTH` levels, or an invalid system.
+        """
+        path = pathname(path, "path", "a system TOML file")
         try:
             with open(path, "rb") as fh:
-                data = tomllib.load(fh)
+                data = toml_document(fh.read().decode("utf-8"))
         except OSError as exc:
             raise ParameterError(f"{path}: cannot read the system file ({exc})") from None
         except UnicodeDecodeError:
             raise ParameterError(f"{path}: not a text (UTF-8) TOML file") from None
+        except TomlNestingError as exc:
+            raise ParameterError(f"{path}: {exc.problem}") from None
         except tomllib.TOMLDecodeError as exc:
             raise ParameterError(f"{path}: not valid TOML: {exc}") from None
         return cls.from_mapping(data, source=str(path))

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from shipblock.checks import MAX_PERIOD, MIN_PERIOD, choice, real
+from shipblock.checks import MAX_PERIOD, MIN_PERIOD, choice, label, real
 from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.intensity import DEFAULT_DAMPING
 from shipblock.models import DEFAULT_MODEL, FieldError, Model, get_model
@@ -321,14 +321,17 @@ class AnalysisDesign:
         Raises
         ------
         ValueError
-            For no records, repeated record ids, an unknown or repeated sweep parameter, an
-            empty or repeated list of values, or an invalid swept system (the message names
-            the parameter values).
+            For no records, repeated record ids, a record id that is not a string or holds a
+            control character (:func:`shipblock.checks.label`), an unknown or repeated sweep
+            parameter, an empty or repeated list of values, or an invalid swept system (the
+            message names the parameter values).
         """
         if not self.records:
             raise ParameterError("the design has no records")
         if len(set(self.records)) != len(self.records):
             raise ParameterError("record ids repeat in the design")
+        for i, record in enumerate(self.records):
+            label(record, f"records[{i}]", what="a record id")
         self.intensity.validate()
         names = [name for name, _ in self.sweep]
         if len(set(names)) != len(names):

@@ -266,10 +266,15 @@ def check_table(table: Mapping, section: str, source: str, model: Model | None =
     ------
     PipelineError
         Naming the key: ``unknown key ...; allowed keys: ...``, ``must be a number, got
-        ...``, ``missing required key ...`` (``section`` for a table of the top level).
+        ...``, ``missing required key ...`` (``section`` for a table of the top level); a key
+        with a control character (a swept parameter ``"a\x00"``) names the section.
     """
     declared = section_fields(section, model)
     for key, given in table.items():
+        if not key.isprintable():
+            raise PipelineError(section, f"key {key!r} holds a control or other non-printable "
+                                f"character; allowed keys: {', '.join(declared) or 'none'}",
+                                source)
         dotted = f"{section}.{key}" if section else key
         if key not in declared:
             raise PipelineError(

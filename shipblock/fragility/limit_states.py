@@ -43,6 +43,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from shipblock import checks
 from shipblock.errors import ParameterError
 from shipblock.models import DEFAULT_MODEL, Model, get_model
 from shipblock.models.base import EDPInfo  # noqa: F401  (importable from here as before)
@@ -127,15 +128,15 @@ class LimitState:
         Raises
         ------
         ValueError
-            Naming the limit state and the offending field: empty name, unknown EDP, unknown
+            Naming the limit state and the offending field: empty name or one with a control or
+            other non-printable character (:func:`shipblock.checks.label`), unknown EDP, unknown
             condition or one that does not apply to the EDP, missing, superfluous, non-numeric,
             non-finite or negative threshold, or a failure code that does not exist.
         """
         model = _model(model)
         edps = model.edps
         who = f"limit state {self.name!r}"
-        if not isinstance(self.name, str) or not self.name.strip():
-            raise ParameterError(f"limit state name must be a non-empty string, got {self.name!r}")
+        checks.label(self.name, "limit state name", what="a non-empty string")
         if self.edp not in edps:
             hint = (
                 " (failure_time is not an EDP; use edp = 'failure')"

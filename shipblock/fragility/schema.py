@@ -57,7 +57,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from shipblock.errors import ParameterTypeError, ShipblockError
+from shipblock import checks
+from shipblock.errors import ParameterTypeError, ShipblockError, TomlNestingError
 from shipblock.fragility.design import (
     IM_LEVEL_RANGE,
     IM_MEASURES,
@@ -291,13 +292,25 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
 
     Raises
     ------
+    ParameterTypeError
+        Naming the argument, if ``text`` is not a ``str`` (``None``, bytes, a path: use
+        :func:`load_pipeline` for a file), ``base`` not a path or ``source`` not a string.
     PipelineError
         Naming the key: unknown key, wrong type, missing section or key, invalid value,
-        unknown record id, invalid system, limit state or design.
+        unknown record id, invalid system, limit state or design; a name (limit state,
+        record id) or file name with a control character; nesting deeper than
+        :data:`shipblock.checks.MAX_TOML_DEPTH` levels.
     """
-    base = Path(base)
+    source = checks.text(source, "source", what="a name for the pipeline in messages")
+    if not isinstance(text, str):
+        raise ParameterTypeError(f"text must be the pipeline's TOML text (a str; "
+                                 f"load_pipeline reads a file), got {type(text).__name__} "
+                                 f"{text!r:.80}")
+    base = Path(checks.pathname(base, "base", "the folder of the pipeline's relative paths"))
     try:
-        doc = tomllib.loads(text)
+        doc = checks.toml_document(text)
+    except TomlNestingError as exc:
+        raise PipelineError("", exc.problem, source) from None
     except tomllib.TOMLDecodeError as exc:
         raise PipelineError("", f"is not valid TOML: {exc}", source) from exc
     check_table(doc, "", source)
@@ -373,7 +386,8 @@ def _records(rec: Mapping, base: Path, source: str):
     """``(ids, catalogue, azimuth, horizontal, response)`` of the ``[records]`` table."""
     from shipblock.records.catalogue import load_catalogue  # reads obspy lazily: start-up time
 
-    catalogue = (base / rec["catalogue"]).resolve() if "catalogue" in rec else None
+    catalogue = (base / _label(rec["catalogue"], "records.catalogue", "a file name", source,
+                               printable=False)).resolve() if "catalogue" in rec else None
     try:
         entries = load_catalogue(catalogue)
     except ShipblockError as exc:
@@ -387,6 +401,8 @@ def _records(rec: Mapping, base: Path, source: str):
     if not ids or not all(isinstance(i, str) for i in ids):
         raise PipelineError("records.ids", "must be a non-empty list of record ids (strings)",
                             source)
+    for k, i in enumerate(ids):
+        _label(i, f"records.ids[{k}]", "a record id", source)
     repeated = sorted({i for i in ids if ids.count(i) > 1})
     if repeated:
         raise PipelineError("records.ids", f"repeats {', '.join(repeated)}", source)
@@ -468,6 +484,18 @@ def _sweep(table: Mapping, source: str) -> tuple:
             raise PipelineError(f"sweep.{name}", f"sweep {name!r} repeats a value", source)
         sweep.append((name, tuple(values)))
     return tuple(sweep)
+
+
+def _label(given: str, key: str, what: str, source: str, printable: bool = True) -> str:
+    """``given`` (a name that becomes a label, coordinate or file name) checked by
+    :func:`shipblock.checks.label`; with ``printable=False`` (the name of a file that exists)
+    only a NUL, which no file name holds, is refused."""
+    if not printable and "\x00" not in given:
+        return given
+    try:
+        return checks.label(given, key, what=what)
+    except ShipblockError as exc:
+        raise PipelineError(key, str(exc), source) from None
 
 
 def _numbers(values, key: str, source: str) -> tuple[float, ...]:
@@ -609,6 +637,9 @@ def _swept_key(design: AnalysisDesign) -> str:
 def _limit_states(entries, design: AnalysisDesign, cloud_method: str, source: str):
     """The limit states, on the model's EDPs."""
     model = design.model
+    for i, entry in enumerate(entries):
+        if isinstance(entry, Mapping) and "name" in entry:
+            _label(entry["name"], f"limit_states[{i}].name", "a limit state name", source)
     try:
         limit_states = parse_limit_states(entries, model)
     except ValueError as exc:
@@ -655,7 +686,9 @@ def _target_spectrum(design: Mapping, intensity: IntensityDesign, base: Path, so
                             f" got {table['period_range']!r}", source)
     match = value(table, key, "match", source)
     try:
-        spectrum = read_target_spectrum(base / table["file"], table["units"])
+        spectrum = read_target_spectrum(
+            base / _label(table["file"], f"{key}.file", "a file name", source, printable=False),
+            table["units"])
         spectrum.at([rng[0], rng[1], intensity.period])
     except TargetSpectrumError as exc:
         raise PipelineError(f"{key}.file", str(exc), source) from None
@@ -691,6 +724,7 @@ def output_path(given: str, base: Path, source: str, key: str = "output") -> Pat
     if not given.strip() or given.endswith(("/", "\\")) or Path(given).name in ("", ".", ".."):
         raise PipelineError(key, f"must name a NetCDF file such as 'results/study.nc', got "
                                  f"{given!r}", source)
+    _label(given, key, "a file name", source)
     path = (base / given).resolve()
     if path.is_dir():
         raise PipelineError(key, f"{path} is a folder; name a NetCDF file in it", source)
@@ -716,6 +750,7 @@ def _parse_histories(table, design, limit_states, base, source) -> HistoryReques
     if not cases and not exceeding:
         raise PipelineError("histories", "select runs with 'runs' and/or 'exceeding'", source)
     max_runs = value(table, "histories", "max_runs", source)
-    directory = (base / table["directory"]).resolve() if "directory" in table else None
+    directory = ((base / _label(table["directory"], "histories.directory", "a folder name",
+                                source)).resolve() if "directory" in table else None)
     return HistoryRequest(tuple(dict.fromkeys(cases)), tuple(exceeding), int(max_runs),
                           directory)

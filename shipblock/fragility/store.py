@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from shipblock import checks
 from shipblock.errors import ShipblockError
 from shipblock.fragility.filesystem import write_failure
 from shipblock.models.rigid import RUN_VARIABLES
@@ -409,6 +410,12 @@ def open_results(path) -> xr.Dataset:
     Returns
     -------
     xarray.Dataset
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``path`` is not a path (``None``, bytes, a number).
     """
+    path = checks.pathname(path, "path", "a result file (NetCDF)")
     with xr.open_dataset(path, engine="netcdf4") as ds:
         return ds.load()

@@ -39,10 +39,12 @@ from __future__ import annotations
 
 import os
 import warnings
+from importlib.metadata import entry_points
 
 import numpy as np
 import obspy
 from obspy.core import AttribDict
+from obspy.core.util.base import ENTRY_POINTS
 
 from shipblock import checks
 from shipblock.errors import ParameterError, ParameterTypeError, RecordError, ShipblockError
@@ -71,10 +73,12 @@ __all__ = [
     "UNITS_GIVEN_KEY",
     "check_count_value",
     "check_format",
+    "check_reader_keywords",
     "check_plausible_samples",
     "check_sampling_interval",
     "known_formats",
     "read_record",
+    "reader_keywords",
     "sensitivity_sign",
 ]
 
@@ -114,10 +118,56 @@ _NUMERIC_KEYWORDS = {
 }
 
 
+#: Keywords of :func:`obspy.read` and of shipblock's own readers: known without loading the
+#: other plug-ins.
+_OWN_READER_KEYWORDS = frozenset(set(checks.keyword_names(obspy.read, 1)).union(
+    *(checks.keyword_names(reader, 1) for _, reader in FORMATS.values())))
+
+
+def reader_keywords() -> frozenset[str]:
+    """The keywords a record read passes on to a reader: those of :func:`obspy.read` and of
+    the reader of every installed obspy waveform plug-in (obspy's formats and shipblock's).
+
+    Loads every plug-in's reader (about half a second): :func:`check_reader_keywords` calls it
+    only for a keyword that is not one of obspy.read's or shipblock's readers'.
+    """
+    names = set(_OWN_READER_KEYWORDS)
+    installed = entry_points()  # one scan of the installed packages' metadata
+    for name in ENTRY_POINTS.get("waveform", {}):
+        for point in installed.select(group=f"obspy.plugin.waveform.{name}", name="readFormat"):
+            try:
+                names.update(checks.keyword_names(point.load(), 1))
+            except (ImportError, AttributeError):  # a broken plug-in has no keywords to offer
+                continue
+    return frozenset(names)
+
+
+def check_reader_keywords(given, function: str, own=()) -> None:
+    """Refuse a keyword that no reader takes (a misspelling: ``unit=`` for ``units=``).
+
+    Parameters
+    ----------
+    given : mapping
+        The keywords passed on to the readers.
+    function : str
+        The public function they were given to, for the message.
+    own : iterable of str
+        That function's own parameters (accepted, and offered as the closest match).
+
+    Raises
+    ------
+    ParameterTypeError
+        Naming the keyword and the closest accepted one (:func:`shipblock.checks.keywords`).
+    """
+    accepted = _OWN_READER_KEYWORDS.union(own)
+    if not set(given) <= accepted:
+        checks.keywords(given, accepted | reader_keywords(), function, listed=set(own) or None,
+                        others="a keyword of obspy.read or of a format's reader "
+                               "(shipblock.io.reader_keywords())" if own else "")
+
+
 def known_formats() -> list[str]:
     """The waveform format names :func:`obspy.read` knows, with shipblock's own (sorted)."""
-    from obspy.core.util.base import ENTRY_POINTS
-
     return sorted(set(ENTRY_POINTS.get("waveform", {})) | set(FORMATS))
 
 
@@ -246,7 +296,9 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
         Passed to the reader: ``dt`` [s] for a one-column text file, ``data_type``
         (``"acceleration"``) for an SMC file whose header says ``0 UNKNOWN``, ``resample_rate`` [Hz] for
         SMC and USC files, ``resample_interval`` [s] for DMG files (each checked: an interval
-        within 1e-4..1 s, a rate within 1..1e4 Hz), or obspy's own keywords.
+        within 1e-4..1 s, a rate within 1..1e4 Hz), or obspy's own keywords (those of
+        :func:`obspy.read` and of its format readers; any other is refused, see
+        :func:`check_reader_keywords`).
 
     Returns
     -------
@@ -259,7 +311,8 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
     ------
     ParameterError
         If an argument is of the wrong type or value (also a :class:`TypeError` for a wrong
-        type): a path that is not a ``str`` or :class:`os.PathLike`, a format obspy does not
+        type): a keyword no reader takes (the closest named), a path that is not a ``str`` or
+        :class:`os.PathLike`, a format obspy does not
         know, an unknown unit, a ``dt``, ``resample_rate`` or ``resample_interval`` out of range.
     RecordError
         If the file does not exist or is a folder, its format is unknown (a file over 16 MB whose
@@ -271,6 +324,7 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
         sampling interval outside 1e-4..1 s; a start time outside 1900-2200; samples in m/s^2
         above 100 g.
     """
+    check_reader_keywords(kwargs, "read_record", ("path", "format", "units"))
     if isinstance(path, (str, os.PathLike)) and os.path.islink(path) and not os.path.exists(path):
         raise RecordError(os.fspath(path), f"is a broken symbolic link (to"
                                            f" {os.readlink(path)!r}, which does not exist)")

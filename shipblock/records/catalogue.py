@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from shipblock import checks
-from shipblock.errors import ParameterError, ParameterTypeError, RecordError
+from shipblock.errors import ParameterError, ParameterTypeError, RecordError, TomlNestingError
 from shipblock.records.arguments import check_read_arguments
 from shipblock.records.folders import MotionSet
 from shipblock.records.motion import COMPONENTS, GroundMotion
@@ -168,6 +168,10 @@ def _entry(table: dict, base: Path, catalogue: Path) -> CatalogueEntry:
                                          f" {table[key]!r}")
     if not table["id"].strip():
         raise RecordError(catalogue, "a record's id is empty: id must be a non-empty string")
+    try:
+        checks.label(table["id"], "id", what="a record id")
+    except ParameterError as exc:
+        raise RecordError(catalogue, f"record {entry_id!r}: {exc}") from None
     files = table["files"]
     if isinstance(files, str):
         files = [files]
@@ -268,12 +272,14 @@ def load_catalogue(path=None) -> dict[str, CatalogueEntry]:
                                      " file; 'shipblock catalogue FOLDER' writes one)")
     try:
         with open(catalogue, "rb") as fh:
-            document = tomllib.load(fh)
+            document = checks.toml_document(fh.read().decode("utf-8"))
     except FileNotFoundError:
         raise RecordError(catalogue, "catalogue file not found (path must name a catalogue TOML"
                                      " file)") from None
     except OSError as exc:
         raise RecordError(catalogue, f"cannot be read: {exc}") from exc
+    except TomlNestingError as exc:
+        raise RecordError(catalogue, exc.problem) from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise RecordError(catalogue, f"is not valid TOML: {exc}") from exc
     version = document.get("schema_version", SCHEMA_VERSION)

@@ -35,7 +35,7 @@ from obspy import Stream
 
 from shipblock import checks
 from shipblock.errors import ParameterError, RecordError, ShipblockError
-from shipblock.io import read_record
+from shipblock.io import check_reader_keywords, read_record
 from shipblock.records.arguments import check_channel_map, check_read_arguments
 from shipblock.records.assembly import assemble_motion, load_stream
 from shipblock.records.motion import GroundMotion
@@ -255,10 +255,13 @@ def read_motions(source, inventory=None, units: str | None = None, *,
         :func:`~shipblock.records.reading.read_motion`: ``units="furlongs"``,
         ``response="partial"``...);
         a wrong option is not a failure of every record.
+    ParameterTypeError
+        For an unknown keyword, naming the closest (``unit``: did you mean ``units``?).
     RecordError
         If the source names nothing, or an inventory or event path names no file; a folder in
         which no file is readable gives an empty set with every failure listed, not an error.
     """
+    check_reader_keywords(read_kwargs, "read_motions", checks.keyword_names(read_motions))
     options = check_read_arguments(inventory=inventory, units=units, response=response,
                                    differentiate=differentiate, align=align, gaps=gaps,
                                    event=event, format=format)

@@ -33,6 +33,7 @@ from obspy import Stream, Trace
 
 from shipblock import checks
 from shipblock.errors import ParameterError, ParameterTypeError, RecordError
+from shipblock.io import check_reader_keywords
 from shipblock.records.arguments import check_channel_map, check_read_arguments
 from shipblock.records.assembly import assemble_motion, load_stream
 from shipblock.records.folders import read_motions
@@ -180,6 +181,8 @@ def read_motion(
         (``"acceleration"``) for SMC files of type ``0 UNKNOWN``, ``resample_rate`` [Hz],
         ``resample_interval`` [s] (:func:`shipblock.io.read_record`). Every option here is also
         a command-line flag and a catalogue entry key (:data:`shipblock.checks.READ_OPTIONS`).
+        Any keyword that neither :func:`obspy.read` nor a format's reader takes is refused
+        before a file is read (``unit="g"``: did you mean ``units``?).
 
     Returns
     -------
@@ -191,7 +194,8 @@ def read_motion(
     ParameterError
         Before any file is read, naming the argument and what it expects (a
         :class:`~shipblock.errors.ParameterTypeError`, also a :class:`TypeError`, for a wrong
-        type): a source that is not a path, list of paths, Stream or Trace; an unknown unit
+        type): a keyword that neither read_motion nor a reader takes, naming the closest
+        one; a source that is not a path, list of paths, Stream or Trace; an unknown unit
         (``units="furlongs"``), response, alignment, gap rule or format; an azimuth that is not a
         number within +-360 deg; a horizontal other than H1/H2, or both; a channel_map that is
         not a dict of components; ``differentiate`` not a bool; ``sensor`` not a string, or one
@@ -206,6 +210,7 @@ def read_motion(
     UnitsError
         If the units of a trace are unknown or contradictory.
     """
+    check_reader_keywords(read_kwargs, "read_motion", checks.keyword_names(read_motion))
     options = check_read_arguments(inventory=inventory, units=units, response=response,
                                    differentiate=differentiate, align=align, gaps=gaps,
                                    event=event, format=format)
