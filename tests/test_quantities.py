@@ -91,3 +91,44 @@ def test_blocks_heavier_than_the_ship_warn():
                                                half_width=1.0, half_height=2.0)
     found = implausible(system)
     assert any("M/(n m) = 0.5" in f for f in found)
+
+
+def test_a_pipeline_system_takes_quantities_with_units():
+    """``ship_mass = "5000 t"`` and ``half_height = "600 mm"`` in a pipeline's [system] give
+    the same system as the SI numbers; a quantity of the wrong dimension names the key."""
+    from pathlib import Path
+
+    from shipblock.fragility.keys import PipelineError
+    from shipblock.fragility.schema import parse_pipeline
+
+    folder = Path(__file__).resolve().parents[1] / "pipelines"
+    text = (folder / "demo.toml").read_text()
+    assert "ship_mass = 5.0e6" in text and "half_height = 0.6 " in text
+    si = parse_pipeline(text, base=folder).design.system
+    with_units = text.replace("ship_mass = 5.0e6", 'ship_mass = "5000 t"').replace(
+        "half_height = 0.6 ", 'half_height = "600 mm" ')
+    assert parse_pipeline(with_units, base=folder).design.system == si
+    with pytest.raises(PipelineError, match=r"'5000 m' is a \[length\], not a \[mass\]") as err:
+        parse_pipeline(text.replace("ship_mass = 5.0e6", 'ship_mass = "5000 m"'), base=folder)
+    assert err.value.key == "system.ship_mass"
+
+
+def test_a_record_without_vertical_is_left_out_when_the_vertical_is_scaled_with_it():
+    """vertical = "same" needs a vertical: a horizontal-only record is left out with the key
+    named, not run horizontal-only (whose only trace would be NaNs in the results)."""
+    from pathlib import Path
+
+    from shipblock import read_motion
+    from shipblock.fragility.batch import prepare_record
+    from shipblock.fragility.design import IntensityDesign
+
+    data = Path(__file__).resolve().parent / "data"
+    horizontal_only = read_motion(str(data / "helena_synthetic_180.AT2"))
+    assert horizontal_only.vertical is None
+    levels = [1.0, 2.0]
+    same = IntensityDesign("ida", levels=levels, vertical="same").validate()
+    left_out = prepare_record("helena.180", lambda: horizontal_only, [], same)
+    assert left_out.error is not None and 'vertical = "same"' in left_out.error
+    assert "has no vertical" in left_out.error
+    zero = IntensityDesign("ida", levels=levels, vertical="zero").validate()
+    assert prepare_record("helena.180", lambda: horizontal_only, [], zero).error is None

@@ -161,6 +161,7 @@ def prepare_record(
     """
     # the processing stack (obspy) loads when the first record is prepared: start-up time
     from shipblock.processing import process_motion
+    from shipblock.records.motion import require_components
     from shipblock.scaling import measure_value, scale_record
 
     n = intensity.n_levels
@@ -168,6 +169,8 @@ def prepare_record(
     try:
         motion = load()
         metadata = motion.metadata
+        if intensity.vertical == "same":  # else the runs would be horizontal-only, silently
+            require_components(motion, ("H1", "V"), record=record_id, key='vertical = "same"')
         if chain is None or list(chain):  # process_motion fails on an empty chain
             motion = process_motion(motion, chain)
             metadata = motion.metadata

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import json
 import logging
-import re
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
@@ -212,8 +211,11 @@ def history_filename(design: AnalysisDesign, case: int) -> str:
     -------
     str
     """
+    # the records package loads obspy: imported when a history is named, not at start-up
+    from shipblock.records.catalogue import record_file_stem
+
     r, j, *sweep = np.unravel_index(int(case), design.shape)
-    parts = [re.sub(r"[^A-Za-z0-9._-]", "_", design.records[int(r)].split("/")[-1])]
+    parts = [record_file_stem(design.records[int(r)].split("/")[-1])]  # never a hidden file
     if design.intensity.scaled:
         parts.append(f"im{int(j)}")
     parts += [f"{name}{int(i)}" for name, i in zip(design.sweep_names, sweep, strict=True)]

@@ -460,8 +460,8 @@ def _system(table: Mapping, model: Model, source: str):
     """The model's system from ``[system]``: each value by its declaration, then the model's
     own checks (:meth:`Model.build <shipblock.models.base.Model.build>`)."""
     params = {k: v for k, v in table.items() if k != "model"}
-    for key in params:
-        value(params, "system", key, source, model)
+    # each value as checked: a quantity with a unit ("5000 t") is in SI from here on
+    params = {key: value(params, "system", key, source, model) for key in params}
     try:
         return model.build(params)
     except FieldError as exc:

@@ -36,6 +36,7 @@ from typing import Any, ClassVar, NamedTuple
 import numpy as np
 
 from shipblock.errors import ParameterError, ParameterTypeError
+from shipblock.quantities import to_si
 
 __all__ = [
     "EDPInfo",
@@ -73,6 +74,9 @@ class FieldError(ParameterError):
 _TYPE_NAMES = {int: "an integer", float: "a number", str: "a string", list: "a list",
                dict: "a table", bool: "true/false"}
 
+# An example of a quantity in the messages, per SI unit.
+_QUANTITY_EXAMPLES = {"kg": "20000 t", "m": "600 mm"}
+
 
 @dataclass(frozen=True)
 class Field:
@@ -104,6 +108,10 @@ class Field:
     default_doc : str
         How the docs state the default when it is not a plain value (e.g. "the shipped
         catalogue").
+    quantity : str or None
+        The SI unit in pint's spelling (``"kg"``, ``"m"``, ``"kg * m**2"``) of a number that
+        may also be given as a string with a unit (``"20000 t"``, ``"600 mm"``), converted
+        to SI by :func:`shipblock.quantities.to_si`; None: numbers only.
     """
 
     name: str
@@ -118,18 +126,24 @@ class Field:
     high_open: bool = False
     choices: tuple[str, ...] | None = None
     default_doc: str = ""
+    quantity: str | None = None
 
     # -- checks --------------------------------------------------------------------------------
     def type_ok(self, value) -> bool:
         """Whether ``value`` has one of the accepted types (a bool only if ``bool`` is one)."""
         if isinstance(value, bool):
             return bool in self.types
+        if isinstance(value, str) and self.quantity is not None:
+            return True  # a quantity with a unit, converted by check()
         kinds = self.types + ((int,) if float in self.types else ())
         return isinstance(value, kinds)
 
     def expected(self) -> str:
         """What the type check asks for, e.g. ``"a number or a string"``."""
-        return " or ".join(_TYPE_NAMES[t] for t in dict.fromkeys(self.types))
+        names = [_TYPE_NAMES[t] for t in dict.fromkeys(self.types)]
+        if self.quantity is not None:
+            names.append(f"a quantity with a unit ('{_QUANTITY_EXAMPLES.get(self.quantity, '1 ' + self.quantity)}')")
+        return " or ".join(names)
 
     def range_text(self, with_units: bool = True) -> str:
         """The accepted range or choices in words (``""`` for none), with the unit or not."""
@@ -175,6 +189,11 @@ class Field:
             infinities included) or a string not among the choices.
         """
         key = key or self.name
+        if self.quantity is not None and isinstance(value, str):
+            try:
+                value = to_si(value, self.quantity, key)
+            except ParameterError as exc:
+                raise FieldError(key, str(exc).removeprefix(f"{key} ")) from None
         self.check_type(value, key)
         if self.choices is not None and isinstance(value, str):
             if value not in self.choices:

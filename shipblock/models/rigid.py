@@ -48,7 +48,14 @@ from shipblock.solver import (
     simulate_batch,
 )
 from shipblock.solver._inputs import ATOL_RANGE, MAX_ZENO_OMEGA, RTOL_RANGE
-from shipblock.system import FIELD_LIMITS, IMPACT_RULES, MIN_INERTIA_RATIO, ShipBlockSystem
+from shipblock.system import (
+    FIELD_LIMITS,
+    FIELD_UNITS,
+    IMPACT_RULES,
+    MIN_INERTIA_RATIO,
+    ShipBlockSystem,
+    warn_implausible,
+)
 
 __all__ = [
     "EDP_VARIABLES",
@@ -166,7 +173,8 @@ def _parameter(name: str) -> Field:
                 "half_width": "required unless slenderness", "block_mass":
                 "required unless mass_ratio"}
     return Field(name, (float,), doc, units or "1", default=None, required=required, low=low,
-                 high=high, low_open=name == "block_inertia", default_doc=defaults.get(name, ""))
+                 high=high, low_open=name == "block_inertia", default_doc=defaults.get(name, ""),
+                 quantity=FIELD_UNITS.get(name))
 
 
 #: The ``[system]`` parameters of the rigid model.
@@ -308,10 +316,12 @@ class RigidModel(Model):
                 raise FieldError(conv, f"{plain} = {conv} x {_FACTOR[plain]} "
                                  f"{exc.problem}") from None
         try:
-            return ShipBlockSystem(**table)
+            system = ShipBlockSystem(**table)
         except (TypeError, ValueError) as exc:
             field = next((f for f, holds in _RELATIONS if not _holds(holds, table)), "")
             raise FieldError(given.get(field, field), str(exc)) from None
+        warn_implausible(system, "the [system] table")  # most likely a unit mistake
+        return system
 
     def vary(self, system: ShipBlockSystem, values: Mapping[str, Any]) -> ShipBlockSystem:
         """:func:`apply_parameters`."""
