@@ -258,7 +258,7 @@ def study_spectra(ds: xr.Dataset) -> dict:
     The study stored each record's spectrum as processed (``record_sa``) and the target as
     given (``target_sa``) on the matching periods. Each record is drawn scaled to the target as
     given, by the factor the study's own scale factors imply at every level: for
-    ``match = "range"`` the least-squares factor in ln Sa, :math:`\ln f = rac1n \sum_i
+    ``match = "range"`` the least-squares factor in ln Sa, :math:`\ln f = \frac1n \sum_i
     \ln(S^*_i / S_i)`; for ``"anchor"``, :math:`f = S^*(T_1) / S(T_1)` (``record_im``), the
     target interpolated in (ln T, ln Sa) as :class:`~shipblock.scaling.TargetSpectrum` does.
 

@@ -460,8 +460,10 @@ def _system(table: Mapping, model: Model, source: str):
     """The model's system from ``[system]``: each value by its declaration, then the model's
     own checks (:meth:`Model.build <shipblock.models.base.Model.build>`)."""
     params = {k: v for k, v in table.items() if k != "model"}
-    # each value as checked: a quantity with a unit ("5000 t") is in SI from here on
-    params = {key: value(params, "system", key, source, model) for key in params}
+    for key, given in list(params.items()):
+        checked = value(params, "system", key, source, model)
+        if isinstance(given, str) and not isinstance(checked, str):
+            params[key] = checked  # a quantity with a unit ("5000 t"), in SI from here on
     try:
         return model.build(params)
     except FieldError as exc:
