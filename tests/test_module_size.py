@@ -23,7 +23,6 @@ OVER_THE_LIMIT = {
     "intensity.py": "the intensity measures and the response spectrum (815 lines)",
     "processing.py": "the processing chain and its steps (805 lines)",
     "io/dmg.py": "the CSMIP/CDMG reader (852 lines)",
-    "cli.py": "the command line: one module per group of sub-commands once the wave's merges land",
 }
 
 ROOT = Path(shipblock.__file__).resolve().parent

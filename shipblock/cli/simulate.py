@@ -1,0 +1,152 @@
+"""``shipblock simulate``: one record on one ship-block system; the summary, NetCDF file and
+figure of a response (also those of ``shipblock history``)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from shipblock.cli._common import SYSTEM_FLAGS, UserError, _save_figure, log
+from shipblock.cli.reading import _horizontal_line, _load_motion
+from shipblock.units import STANDARD_GRAVITY
+
+
+def _system_from_args(args):
+    """The system of --system and the system flags; quantities with units converted to SI
+    (shipblock.quantities), and a warning for a system outside any dock
+    (shipblock.system.warn_implausible)."""
+    from shipblock.quantities import to_si
+    from shipblock.system import FIELD_UNITS, ShipBlockSystem, warn_implausible
+
+    system = ShipBlockSystem.from_toml(args.system) if args.system else ShipBlockSystem.example()
+    changes = {k: getattr(args, k) for k in SYSTEM_FLAGS if getattr(args, k) is not None}
+    changes = {k: to_si(v, FIELD_UNITS[k], SYSTEM_FLAGS[k][0]) if k in FIELD_UNITS else v
+               for k, v in changes.items()}
+    if not changes:
+        return system
+    system = system.replace(**changes)
+    warn_implausible(system, "the command line's system")
+    return system
+
+
+def _scaled_input(args, motion):
+    """The horizontal and vertical to simulate, and the scale phrase of the figure's title."""
+    from shipblock.scaling import acceleration_target, scale_record
+
+    vertical = None if args.no_vertical else motion.vertical
+    if args.target_pga is None:
+        factor = 1.0 if args.scale is None else args.scale
+        ax = motion.horizontal * factor
+        ay = None
+        if vertical is not None:
+            ay = vertical * (factor if args.vertical_scale is None else args.vertical_scale)
+        return ax, ay, factor
+    if args.scale is not None:
+        raise UserError("give --scale or --target-pga, not both")
+    target = acceleration_target(args.target_pga, "--target-pga")
+    options = {"target": target, "measure": "pga"}
+    if vertical is not None and args.vertical_scale is not None:
+        options.update(vertical_mode="independent", vertical_factor=args.vertical_scale)
+    scaled = scale_record(motion.horizontal, vertical, motion.dt, **options)
+    log.info("scaled to PGA %.4g g: factor %.4g on the horizontal%s", target / STANDARD_GRAVITY,
+             scaled.factor_h, "" if vertical is None else f", {scaled.factor_v:.4g} on the vertical")
+    return (scaled.horizontal, scaled.vertical,
+            f"scaled to PGA {target / STANDARD_GRAVITY:.3g} g (factor {scaled.factor_h:.4g})")
+
+
+def cmd_simulate(args):
+    from shipblock.plot import record_text
+    from shipblock.solver import simulate
+
+    system = _system_from_args(args)
+    motion = _load_motion(args)
+    ax, ay, scale = _scaled_input(args, motion)
+    log.info("simulating %d samples at dt = %g s", ax.size, motion.dt)
+    sys.stdout.write(f"horizontal  {_horizontal_line(motion)}\n")
+    res = simulate(system, ax, ay, motion.dt, rtol=args.rtol)
+    name = motion.name
+    record = record_text(motion, scale)
+    _report(res, name, args.events)
+    if args.output:
+        ds = res.to_dataset()
+        ds.attrs["record"] = str(name)
+        ds.attrs["record_description"] = record
+        ds.attrs["processing"] = "\n".join(motion.metadata.get("processing", []) or [])
+        _write_response(ds, args.output)
+    _response_figure_option(res, record, args.figure, args.output)
+    return 0
+
+
+def _write_response(ds, output):
+    from shipblock.fragility.store import write_dataset
+
+    write_dataset(ds, output)
+    sys.stdout.write(f"response written to {output}\n")
+
+
+def _response_figure_option(res, record, figure, output):
+    if figure is None and output:
+        figure = str(Path(output).with_suffix(".png"))
+    if figure:
+        _save_figure(lambda: _response_figure(res, record), figure)
+        sys.stdout.write(f"figure written to {figure}\n")
+
+
+def _report(res, name, max_events):
+    """Print the summary of a simulation: record, system, failure, peaks, modes, events."""
+    import numpy as np
+
+    out = sys.stdout
+    system = res.system
+    ax = res.ground_acceleration[0]
+    dt = float(res.time[1] - res.time[0])
+    s = res.summary
+    rows = [
+        ("record", f"{name} ({ax.size} samples, dt = {dt:g} s, "
+                   f"PGA_H = {np.abs(ax).max() / STANDARD_GRAVITY:.3f} g)"),
+        ("system", f"M = {system.ship_mass:.4g} kg on {system.n_blocks} blocks of "
+                   f"{system.block_mass:.4g} kg, 2B x 2H = {2 * system.half_width:g} x "
+                   f"{2 * system.half_height:g} m, e = {system.effective_restitution:.3f}"),
+        ("failure", "none" if res.failure is None else f"{res.failure} at t = {res.failure_time:.4f} s"),
+        ("peak block slip |x_b|", f"{100 * s['peak_block_slip']:.3f} cm"),
+        ("peak ship slip |x_s|", f"{100 * s['peak_ship_slip']:.3f} cm"),
+        ("peak rotation |theta|", f"{1000 * s['peak_rotation']:.3f} mrad "
+                                  f"({100 * s['peak_rotation_ratio']:.1f} % of theta_c)"),
+        ("residual x_b / x_s", f"{100 * s['residual_block_slip']:.3f} / "
+                               f"{100 * s['residual_ship_slip']:.3f} cm"),
+        ("uplift / impacts", f"{'yes' if s['uplift'] else 'no'} / {s['n_impacts']}"),
+        ("peak loads per block", f"floor {s['peak_ground_normal_force'] / 1e3:.1f} kN, friction "
+                                 f"{s['peak_ground_friction_force'] / 1e3:.1f} kN "
+                                 f"(utilisation {s['peak_ground_friction_utilisation']:.2f}); ship "
+                                 f"{s['peak_ship_normal_force'] / 1e3:.1f} kN, friction "
+                                 f"{s['peak_ship_friction_force'] / 1e3:.1f} kN "
+                                 f"(utilisation {s['peak_ship_friction_utilisation']:.2f})"),
+    ]
+    if s["uplift"]:
+        rows.append(("peak corner load", f"{s['peak_corner_load'] / 1e3:.1f} kN per block, on "
+                                         "the pivot edge while rocking"))
+    width = max(len(r[0]) for r in rows)
+    for key, val in rows:
+        out.write(f"{key:<{width}}  {val}\n")
+    out.write("time per mode:\n")
+    from shipblock.modes import MODE_DESCRIPTIONS
+
+    for m in range(1, 9):
+        tm = s[f"time_in_mode_{m}"]
+        if tm > 0:
+            out.write(f"  {m} {MODE_DESCRIPTIONS[m]:<36} {tm:9.3f} s\n")
+    counts = {}
+    for e in res.events[1:]:
+        counts[e.kind] = counts.get(e.kind, 0) + 1
+    out.write("events: " + (", ".join(f"{k} {v}" for k, v in sorted(counts.items())) or "none") + "\n")
+    shown = [e for e in res.events[1:] if e.kind != "impact"][:max_events]
+    for e in shown:
+        out.write(f"  t = {e.time:10.5f} s  {e.kind:<18} mode {e.from_mode} -> {e.to_mode}\n")
+
+
+def _response_figure(res, record):
+    """The response figure, ``record`` the first line of its title (:func:`plot_response`;
+    None: a response dataset's own)."""
+    from shipblock.plot import plot_response
+
+    return plot_response(res, record=record)[0].figure
