@@ -49,7 +49,7 @@ from shipblock.equations import (
     solve_mode,
 )
 from shipblock.modes import MODE_NUMBER
-from shipblock.solver._events import event_functions, rearm
+from shipblock.solver._events import event_functions, note_held_margin, rearm
 from shipblock.solver._ground import ground_motion_at
 from shipblock.solver._history import store_sample
 from shipblock.solver._layout import (
@@ -553,7 +553,7 @@ def mode_response_start(p, work, slip1, sig1, slip2, sig2):
 # inlined into the kernel's loop: a call passed some 75 machine words of arguments at every
 # event, a few per cent of a stick-slip record's time
 @njit(cache=True, error_model="numpy", _nrt=False, forceinline=True)
-def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs,
+def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, levels, peak_xb, peak_xs,
                     store, hist, modes, work, summary):
     """Advance a non-rocking mode sample by sample until an event or the end of the record.
 
@@ -569,8 +569,9 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         Current sample interval and time into it [s].
     dt, ax, ay, has_ay, sh, sv
         Record and scale factors as in :func:`shipblock.solver._kernel.run`.
-    armed : ndarray of bool
-        Events being watched; disarmed ones are re-armed once clear of zero.
+    levels : ndarray
+        The level below which each event function fires (0, shifted or -inf: see
+        :func:`~shipblock.solver._events.shifted_level`); restored to 0 once clear of zero.
     peak_xb, peak_xs : float
         Running peaks of |x_b| and |x_s| at the samples.
     store, hist, modes
@@ -637,9 +638,15 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
     # start, its samples, its end): the forces are linear in it, so their peaks are at these two
     a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # the start
     a_lo = a_hi = a0
+    # the run's least constraint margin (the audit, S_MARGIN): at the start, at the ends of
+    # the intervals the screen does not pass (it passes only those where every held condition
+    # holds) and at the event
+    note_held_margin(p, ms, y, fx_a * a0 + fx_g * (grav + b0), fy_a * a0 + fy_g * (grav + b0),
+                     Fx_a * a0 + Fx_g * (grav + b0), Fy_a * a0 + Fy_g * (grav + b0), g, np.int64(-1),
+                     summary)
     all_armed = True
     for e in range(N_EVENTS):
-        if not armed[e]:
+        if levels[e] != 0.0:
             all_armed = False
     time_in_mode = 0.0  # accumulated here, added to the summary by the caller
     if not slip1 and not slip2 and all_armed and y[Y_VB] == 0.0 and y[Y_VS] == 0.0:
@@ -708,29 +715,33 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
             best_e = -1
             for ie in range(N_EVENTS):
                 e = EVENT_PRIORITY[ie]
-                # only the events a non-rocking mode can meet, and only armed ones
-                if not armed[e] or e in (EV_IMPACT, EV_OVERTURN) \
+                # only the events a non-rocking mode can meet, and not disarmed ones; each
+                # crosses its level (0 unless shifted)
+                level = levels[e]
+                if level == -math.inf or e in (EV_IMPACT, EV_OVERTURN) \
                         or (e == EV_G_STICK and slip1) or (e == EV_G_SLIP and not slip1) \
                         or (e == EV_S_STICK and slip2) or (e == EV_S_SLIP and not slip2):
                     continue
                 if e == EV_SEP_G:
-                    r = linear_root(fy0 * inv_w, fy1 * inv_w, h)
+                    r = linear_root(fy0 * inv_w - level, fy1 * inv_w - level, h)
                 elif e == EV_SEP_S:
-                    r = linear_root(Fy0 * inv_ws, Fy1 * inv_ws, h)
+                    r = linear_root(Fy0 * inv_ws - level, Fy1 * inv_ws - level, h)
                 elif e == EV_G_STICK:
-                    r = min_linear_root((mus1 * fy0 - fx0) * inv_w, (mus1 * fy1 - fx1) * inv_w,
-                                        (mus1 * fy0 + fx0) * inv_w, (mus1 * fy1 + fx1) * inv_w,
-                                        h)
+                    r = min_linear_root((mus1 * fy0 - fx0) * inv_w - level,
+                                        (mus1 * fy1 - fx1) * inv_w - level,
+                                        (mus1 * fy0 + fx0) * inv_w - level,
+                                        (mus1 * fy1 + fx1) * inv_w - level, h)
                 elif e == EV_S_STICK:
-                    r = min_linear_root((mus2 * Fy0 - Fx0) * inv_ws, (mus2 * Fy1 - Fx1) * inv_ws,
-                                        (mus2 * Fy0 + Fx0) * inv_ws, (mus2 * Fy1 + Fx1) * inv_ws,
-                                        h)
+                    r = min_linear_root((mus2 * Fy0 - Fx0) * inv_ws - level,
+                                        (mus2 * Fy1 - Fx1) * inv_ws - level,
+                                        (mus2 * Fy0 + Fx0) * inv_ws - level,
+                                        (mus2 * Fy1 + Fx1) * inv_ws - level, h)
                 elif e == EV_UPLIFT:
                     r = min_linear_root(
-                        (B * (fy0 + Fy0) - H * (fx0 + Fx0)) * inv_wr,
-                        (B * (fy1 + Fy1) - H * (fx1 + Fx1)) * inv_wr,
-                        (B * (fy0 + Fy0) + H * (fx0 + Fx0)) * inv_wr,
-                        (B * (fy1 + Fy1) + H * (fx1 + Fx1)) * inv_wr, h)
+                        (B * (fy0 + Fy0) - H * (fx0 + Fx0)) * inv_wr - level,
+                        (B * (fy1 + Fy1) - H * (fx1 + Fx1)) * inv_wr - level,
+                        (B * (fy0 + Fy0) + H * (fx0 + Fx0)) * inv_wr - level,
+                        (B * (fy1 + Fy1) + H * (fx1 + Fx1)) * inv_wr - level, h)
                 elif e == EV_G_SLIP:
                     r = quadratic_root(sig1 * vb0, sig1 * ub0, sig1 * (ub1 - ub0) / (2.0 * h), h)
                 else:  # EV_S_SLIP
@@ -739,10 +750,16 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
                 if r < best_h - 2.0 * ROOT_TIME_TOL:
                     best_h = r
                     best_e = e
-            if best_e >= 0:
+            if best_e < 0:
+                note_held_margin(p, ms, y, fx1, fy1, Fx1, Fy1, g, np.int64(-1), summary)
+            else:
                 # advance to the event: the same polynomials, cut at best_h (u = best_h / h)
                 u = best_h / h
                 a_end = a0 + (a1 - a0) * u
+                if best_e != EV_SEP_G and best_e != EV_SEP_S:  # (as the kernel's events)
+                    note_held_margin(p, ms, y, fx0 + (fx1 - fx0) * u, fy0 + (fy1 - fy0) * u,
+                                     Fx0 + (Fx1 - Fx0) * u, Fy0 + (Fy1 - Fy0) * u, g, best_e,
+                                     summary)
                 y[Y_XB], y[Y_XS], y[Y_WIN], y[Y_DIS] = xb, xs, w_in, dis
                 y[Y_VB], y[Y_VS] = vb, vs
                 exact_update(y, best_h, ub0, ub0 + (ub1 - ub0) * u, us0, us0 + (us1 - us0) * u,
@@ -785,7 +802,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
             if not all_armed:
                 event_functions(p, ms, y, fx1, fy_a * a1 + fy_g * G1, Fx1,
                                 Fy_a * a1 + Fy_g * G1, g)
-                all_armed = rearm(armed, g)
+                all_armed = rearm(levels, g)
             if store:
                 store_sample(p, ms, y, hist, modes, k, mode)
     y[Y_XB], y[Y_VB], y[Y_XS], y[Y_VS], y[Y_WIN], y[Y_DIS] = xb, vb, xs, vs, w_in, dis

@@ -66,7 +66,14 @@ S_PEAK_SFX = 28  # blocks on ship, |friction|
 S_PEAK_UTIL_G = 29  # |fx| / (mu_s1 fy)
 S_PEAK_UTIL_S = 30  # |Fx| / (mu_s2 Fy)
 S_PEAK_CORNER = 31  # fy while the blocks rock (on their pivot corners)
-N_SUMMARY = 32
+# The least margin of the conditions the mode holds (stick cones, the blocks' moment criterion,
+# normal forces: EV_G_STICK, EV_S_STICK, EV_UPLIFT, EV_SEP_G, EV_SEP_S where they apply) over the
+# ends of the run's accepted steps and samples and both sides of its events (the event's own
+# function excluded on the side it fires) [-], see shipblock.solver._events.held_margin; at
+# least -FORCE_TOL when every constraint holds to the tolerance (issue 32). Not one of the
+# batch's fields: simulate reports it as "least_constraint_margin".
+S_MARGIN = 32
+N_SUMMARY = 33
 
 # Work array of the closed-form spans (one per run, see ``nonrocking_span``): the event
 # functions, then per response slot its state (0 not solved, 1 solved, 2 singular) and its two
