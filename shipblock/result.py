@@ -16,7 +16,7 @@ _PIVOT_RATE = np.nextafter(0.0, 1.0)
 
 
 def _with_pivot(mode, theta, theta_dot, v_b, v_s, system, ax, ay):
-    """``theta_dot`` with the pivot marked where the blocks rock from theta = theta_dot = 0.
+    r"""``theta_dot`` with the pivot marked where the blocks rock from theta = theta_dot = 0.
 
     The forces of a rocking mode depend on its pivot ``s``, which the histories give as the
     sign of theta, or of theta_dot where theta is 0. At a sample where the blocks rock with

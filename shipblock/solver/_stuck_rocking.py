@@ -468,7 +468,7 @@ def note_margin(p, s, th1, fx1, fy1, Fx1, Fy1, g1, summary):
 
 @njit(cache=True, forceinline=True)
 def held_at_impact(p, s, th_i, om_i, al_i, a_i, b_i):
-    """Whether the conditions mode 3 holds (both stick cones, both normal forces) hold at the
+    r"""Whether the conditions mode 3 holds (both stick cones, both normal forces) hold at the
     impact that ends a step, at the rotation ``th_i`` within ``ROOT_TIME_TOL`` of zero.
 
     The end of the step, past the impact, tells nothing about them: there the mode's equations

@@ -131,7 +131,7 @@ def _slender_system(rng, slenderness, mu_ground, mu_ship, mass_ratio):
 
 
 def painleve_thresholds(slenderness, mass_ratio, kappa=1.0 / 3.0):
-    """Friction above which a slipping interface makes the rocking's effective inertia negative
+    r"""Friction above which a slipping interface makes the rocking's effective inertia negative
     at theta = 0 (the Painleve regime): ``(mu_ground, mu_ship)``.
 
     From the denominators of the mode-6 and mode-7 closed forms
