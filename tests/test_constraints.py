@@ -29,14 +29,14 @@ from shipblock.modes import MODE_FLAGS
 from shipblock.solver._interpolate import dip_possible, poly5, quintic_hermite, rotation_dip
 from shipblock.solver._layout import FORCE_TOL
 
-from .tools.random_campaign import sample_margins
+from .tools.random_campaign import KERNEL_ROUNDING, sample_margins
 
 G0 = 9.80665
 
 
 def _assert_constraints_hold(res):
     """The kernel's least margin and the margins recomputed at the samples, to FORCE_TOL."""
-    assert res.summary["least_constraint_margin"] >= -FORCE_TOL
+    assert res.summary["least_constraint_margin"] >= -FORCE_TOL - KERNEL_ROUNDING
     for name, margin in sample_margins(res).items():
         assert margin >= -FORCE_TOL - 1e-12, (name, margin)
 
@@ -153,7 +153,8 @@ def test_slow_crossing_of_the_uplift_threshold():
     uplift = [e for e in res.events if e.kind == "uplift" and MODE_FLAGS[e.to_mode, 1]]
     assert len(uplift) == 1
     R = system.half_diagonal
-    assert t_star <= uplift[0].time <= t_star + FORCE_TOL * R * G0 / (system.half_height * k) * 1.001
+    late = FORCE_TOL * R * G0 / (system.half_height * k)
+    assert t_star <= uplift[0].time <= t_star + late * 1.001
     assert res.summary["uplift"] and res.theta[-1] > 0
 
 

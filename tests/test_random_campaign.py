@@ -5,7 +5,8 @@ restitution) under random smoothed one- and two-component records, at the defaul
 Every run must pass the campaign's checks: known outcome (no solver error), energy balance, no
 energy gained in an impact or a jam under the momentum and plastic rules, a valid event
 sequence, and every condition its modes hold kept to the force tolerance (the constraint audit,
-issue 32), also in the strata where that is hardest. Its residual must be within 1e-6 of the input work, or else converge there: the runs
+issue 32), also in the strata where that is hardest.
+Its residual must be within 1e-6 of the input work, or else converge there: the runs
 above it (about 1 in 10,000) are almost all runs whose rocking is tiny (rotations of 1e-12 to
 1e-4 rad, often thousands of impacts), where the default tolerances are not small against the
 motion itself; at rtol = 1e-12, atol = 1e-14 each is within 1e-6, or at round-off (below 1e-15

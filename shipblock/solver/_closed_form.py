@@ -108,12 +108,16 @@ FAST_BLOCK = 64
 def linear_root(l0, l1, h):
     """Time in [0, h] at which a linear function going from ``l0`` to ``l1`` turns negative.
 
-    ``inf`` if it ends non-negative; 0 if it starts on or below zero (the event is due now).
+    ``inf`` if it ends non-negative; 0 if it starts on or below zero and falls (the event is
+    due now); ``inf`` if it starts below zero and rises: a force event watched at a shifted
+    level whose function stood at or just below that level at the event that kept its mode
+    (the mode selection found the condition held, and it is recovering) does not fire again
+    at once (:func:`~shipblock.solver._events.shifted_level`).
     """
     if l1 >= 0.0:
         return NO_ROOT
     if l0 <= 0.0:
-        return 0.0
+        return 0.0 if l1 < l0 else NO_ROOT
     return h * l0 / (l0 - l1)
 
 
@@ -126,8 +130,6 @@ def min_linear_root(la0, la1, lb0, lb1, h):
     """
     if min(la1, lb1) >= 0.0:
         return NO_ROOT
-    if min(la0, lb0) <= 0.0:
-        return 0.0
     return min(linear_root(la0, la1, h), linear_root(lb0, lb1, h))
 
 
@@ -638,12 +640,6 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, levels, peak_x
     # start, its samples, its end): the forces are linear in it, so their peaks are at these two
     a0, b0 = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau, dt)  # the start
     a_lo = a_hi = a0
-    # the run's least constraint margin (the audit, S_MARGIN): at the start, at the ends of
-    # the intervals the screen does not pass (it passes only those where every held condition
-    # holds) and at the event
-    note_held_margin(p, ms, y, fx_a * a0 + fx_g * (grav + b0), fy_a * a0 + fy_g * (grav + b0),
-                     Fx_a * a0 + Fx_g * (grav + b0), Fy_a * a0 + Fy_g * (grav + b0), g, np.int64(-1),
-                     summary)
     all_armed = True
     for e in range(N_EVENTS):
         if levels[e] != 0.0:
@@ -750,6 +746,9 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, levels, peak_x
                 if r < best_h - 2.0 * ROOT_TIME_TOL:
                     best_h = r
                     best_e = e
+            # the run's least constraint margin (the audit, S_MARGIN): at the ends of the
+            # intervals the screen does not pass (it passes only those where every held
+            # condition holds), and up to the event
             if best_e < 0:
                 note_held_margin(p, ms, y, fx1, fy1, Fx1, Fy1, g, np.int64(-1), summary)
             else:

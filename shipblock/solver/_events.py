@@ -29,6 +29,7 @@ from shipblock.solver._layout import (
     MS_SLIP1,
     MS_SLIP2,
     FORCE_TOL,
+    LEVEL_GAP,
     N_EVENTS,
     REARM_TOL,
     S_MARGIN,
@@ -58,9 +59,10 @@ def rearm(levels, g):
 
 
 @njit(cache=True, forceinline=True)
-def shifted_level(e, level):
-    """The level at which event ``e`` is watched after it fired at ``level`` and the mode
-    selection kept the mode: the event is shifted, not switched off.
+def shifted_level(e, level, value):
+    """The level at which event ``e`` is watched after it fired at ``level`` (its function
+    then at ``value``) and the mode selection kept the mode: the event is shifted, not
+    switched off.
 
     A force event (the friction cones, the blocks' moment criterion) is watched again halfway
     from its level to ``-FORCE_TOL``, the tolerance of the mode selection's held conditions in
@@ -68,12 +70,18 @@ def shifted_level(e, level):
     constraint that merely touched zero stays watched, and one that goes on being violated
     fires again before its violation exceeds the tolerance, when the mode selection, now
     seeing a violation beyond half of it grow, releases it. The levels ``-FORCE_TOL/2``,
-    ``-3 FORCE_TOL/4``, ... never pass ``-FORCE_TOL``. A velocity event (a slip velocity
-    brought to zero and moving on the same way) is disarmed (``-inf``) until clear of zero,
-    as before 2026-11-26; the other events never keep their mode.
+    ``-3 FORCE_TOL/4``, ... tend to ``-FORCE_TOL``; the level is at least ``LEVEL_GAP`` below
+    the function's value, so that an event does not fire again at the same instant where the
+    levels have come within rounding of ``-FORCE_TOL`` (the selection computes the margin its
+    own way, and at the tolerance's edge the two may differ by some 1e-16): one more firing
+    then needs the function to fall by ``LEVEL_GAP``, and the selection releases the
+    constraint once its own margin is past the tolerance, so the function never goes past
+    ``-FORCE_TOL`` by more than rounding and a few ``LEVEL_GAP``. A velocity event (a slip
+    velocity brought to zero and moving on the same way) is disarmed (``-inf``) until clear of
+    zero, as before 2026-11-26; the other events never keep their mode.
     """
     if e == EV_G_STICK or e == EV_S_STICK or e == EV_UPLIFT:
-        return 0.5 * (level - FORCE_TOL)
+        return min(0.5 * (level - FORCE_TOL), value - LEVEL_GAP)
     return -math.inf
 
 

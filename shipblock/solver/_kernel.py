@@ -64,7 +64,7 @@ from shipblock.solver._events import (
     rotation_event,
     shifted_level,
 )
-from shipblock.solver._ground import ground_motion_at
+from shipblock.solver._ground import ground_motion_at, one_sided_motion
 from shipblock.solver._history import store_sample
 from shipblock.solver._interpolate import (
     bracketed_root,
@@ -323,9 +323,10 @@ def locate_root(e, level, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, 
     """Illinois iteration for the step length at which event ``e`` crosses its ``level`` (0,
     or the shifted level of :func:`~shipblock.solver._events.shifted_level`).
 
-    ``g_lo >= 0 > g_hi``, both relative to ``level``. ``guess`` (ignored unless inside the bracket) is a first estimate of
-    the root, e.g. from an interpolant: it and a point ``GUESS_PROBE`` beyond it are tried
-    first, which usually leaves a bracket a few ``ROOT_TIME_TOL`` wide. Returns the violated
+    ``g_lo >= 0 > g_hi``, both relative to ``level``. ``guess`` (ignored unless inside the
+    bracket) is a first estimate of the root, e.g. from an interpolant: it and a point
+    ``GUESS_PROBE`` beyond it are tried first, which usually leaves a bracket a few
+    ``ROOT_TIME_TOL`` wide. Returns the violated
     end of the final bracket (width <= ROOT_TIME_TOL), so the event has just happened there.
     """
     if lo < guess < hi:
@@ -515,8 +516,9 @@ def select_mode(p, y, ms, a, b, trigger, w7, work, lead, alpha):
     after an impact) rocks on the pivot given by that sign; one at rest may stay or start rocking
     on either corner. Each candidate is evaluated ONE_SIDED_DT after the event (the ground input
     ``a``, ``b`` there; a rotation ``theta != 0`` advanced along the motion by ``lead``, see
-    below) and is consistent when stick forces lie inside their static friction cones, the block-rest moment criterion
-    holds, new motions accelerate in their assumed direction and both normal forces are positive.
+    below) and is consistent when stick forces lie inside their static friction cones, the
+    block-rest moment criterion holds, new motions accelerate in their assumed direction and
+    both normal forces are positive.
     Among consistent candidates the one with the fewest new motions wins; ties go to the one
     releasing ``trigger`` (0 ground, 1 rocking, 2 ship), then to the lower paper mode number.
     If none is consistent, the system separates when every candidate has a non-positive normal
@@ -951,7 +953,6 @@ summary, y_init
     event_values(p, ms, y, k, 0.0, dt, ax, ay, has_ay, sh, sv, g0, w7)
     if failure == 0:
         note_loads(p, ms[MS_ROCK], w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY], summary)
-        summary[S_MARGIN] = min(summary[S_MARGIN], held_margin(g0, np.int64(-1)))
     if store:
         if jammed:
             # sample 0 holds the initial state as given (the jam at t = 0 shows from sample 1 on),
@@ -1060,7 +1061,10 @@ summary, y_init
                     hi = h
                     g_hi = g1[e] - level
                     fired = False
-                    if g_hi < 0.0:
+                    if g_hi < 0.0 and (g_lo > 0.0 or has_slope(e) or g_hi < g_lo):
+                        # (a force event that starts at or below its level fires only if it
+                        # falls further: one at a shifted level whose mode was kept, recovering,
+                        # does not fire again at once; see linear_root)
                         fired = True
                         if g_lo <= 0.0:
                             # started on the boundary: look for the interior maximum first
@@ -1209,7 +1213,8 @@ summary, y_init
             jam_from = from_mode
             if failure == 0:
                 old0, old1, old2, old3, old4, old5 = ms[0], ms[1], ms[2], ms[3], ms[4], ms[5]
-                a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + ONE_SIDED_DT,
+                # the input's one-sided limit: on the line of this sample interval
+                a_next, b_next = one_sided_motion(ax, ay, has_ay, sh, sv, k, tau, ONE_SIDED_DT,
                                                   dt)
                 # the rotation along the motion too, but for an impact (its pivot is new)
                 lead = ONE_SIDED_DT if best_e != EV_IMPACT else 0.0
@@ -1217,8 +1222,8 @@ summary, y_init
                                      alpha)
                 jam_loss = 0.0
                 if status != 0:
-                    a_wide, b_wide = ground_motion_at(ax, ay, has_ay, sh, sv, k,
-                                                      tau + ONE_SIDED_WIDE, dt)
+                    a_wide, b_wide = one_sided_motion(ax, ay, has_ay, sh, sv, k, tau,
+                                                      ONE_SIDED_WIDE, dt)
                     status, jam_loss, jammed, jam_from = resolve_mode(
                         p_vec, y, ms, a_next, b_next, a_wide, b_wide, trigger, w7, span_work, K,
                         status, ONE_SIDED_WIDE if best_e != EV_IMPACT else 0.0, alpha)
@@ -1242,7 +1247,8 @@ summary, y_init
                         # the constraint touched zero and held again as far as the selection
                         # looked: watched on at a shifted level (a force), off until clear of
                         # zero (a slip velocity), see shifted_level
-                        levels[best_e] = shifted_level(best_e, levels[best_e])
+                        event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, gw, w7)
+                        levels[best_e] = shifted_level(best_e, levels[best_e], gw[best_e])
                     else:
                         for e in range(N_EVENTS):
                             levels[e] = 0.0
@@ -1250,10 +1256,6 @@ summary, y_init
                         uplift = 1
                     if ms[MS_ROCK]:
                         state_loads(p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary)
-                        # the new mode's held conditions at the event (a non-rocking mode's:
-                        # at the start of its span)
-                        event_functions(p, ms, y, w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY], gw)
-                        summary[S_MARGIN] = min(summary[S_MARGIN], held_margin(gw, np.int64(-1)))
                     else:
                         # a non-rocking mode's forces here start its span, noted by span_loads;
                         # noted after the loop if no span follows
