@@ -695,8 +695,9 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, levels, peak_x
         # quadratic and can also dip below zero inside. Only a suspect interval is searched.
         # The held conditions (normal forces, moment criterion, stick cones) need no check
         # inside [lo, hi]; the normal forces are then not computed at all.
-        suspect = not all_armed or not lo <= a1 <= hi and held_fails_at(
+        held_fails = not lo <= a1 <= hi and held_fails_at(
             slip1, slip2, a1, G1, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
+        suspect = held_fails or not all_armed
         # a slipping interface: its slip may stop
         if slip1:
             suspect = suspect or slip_may_stop(sig1, vb0, ub0, ub1, h)
@@ -750,7 +751,8 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, levels, peak_x
             # intervals the screen does not pass (it passes only those where every held
             # condition holds), and up to the event
             if best_e < 0:
-                note_held_margin(p, ms, y, fx1, fy1, Fx1, Fy1, g, np.int64(-1), summary)
+                if held_fails or not all_armed:
+                    note_held_margin(p, ms, y, fx1, fy1, Fx1, Fy1, g, np.int64(-1), summary)
             else:
                 # advance to the event: the same polynomials, cut at best_h (u = best_h / h)
                 u = best_h / h

@@ -168,11 +168,24 @@ def stuck_rocking_clear(p, s, theta, fx, fy, Fx, Fy):
             and fy >= 0.0 and Fy >= 0.0 and s * theta >= 0.0 and p[P_THC] - s * theta >= 0.0)
 
 
-@njit(cache=True, forceinline=False, _nrt=False)
+@njit(cache=True, forceinline=True)
+def held_clear(p, ms, fx, fy, Fx, Fy):
+    """Whether every condition mode ``ms`` holds is met (margin >= 0) under the interface
+    forces ``fx, fy, Fx, Fy`` [N]: the signs of the numerators of :func:`event_functions`,
+    without its divisions, the screen of :func:`note_held_margin`."""
+    return ((ms[MS_SLIP1] != 0 or p[P_MUS1] * fy - abs(fx) >= 0.0)
+            and (ms[MS_SLIP2] != 0 or p[P_MUS2] * Fy - abs(Fx) >= 0.0)
+            and (ms[MS_ROCK] != 0 or p[P_B] * (fy + Fy) - p[P_H] * abs(fx + Fx) >= 0.0)
+            and fy >= 0.0 and Fy >= 0.0)
+
+
+@njit(cache=True, forceinline=True)
 def note_held_margin(p, ms, y, fx, fy, Fx, Fy, g, skip, summary):
     """Lower the run's least constraint margin (``S_MARGIN``) by the held conditions of mode
     ``ms`` under the interface forces ``fx, fy, Fx, Fy`` [N], leaving out event ``skip``
-    (-1: none); ``g`` is work for the event functions."""
-    event_functions(p, ms, y, fx, fy, Fx, Fy, g)
-    summary[S_MARGIN] = min(summary[S_MARGIN], held_margin(g, skip))
+    (-1: none); ``g`` is work for the event functions, computed only where a condition is not
+    clear of zero (:func:`held_clear`): a margin >= 0 cannot lower the least one."""
+    if not held_clear(p, ms, fx, fy, Fx, Fy):
+        event_functions(p, ms, y, fx, fy, Fx, Fy, g)
+        summary[S_MARGIN] = min(summary[S_MARGIN], held_margin(g, skip))
 

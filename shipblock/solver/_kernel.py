@@ -60,6 +60,7 @@ from shipblock.solver._events import (
     event_functions,
     held_margin,
     impact_return_time,
+    note_held_margin,
     rearm,
     rotation_event,
     shifted_level,
@@ -1170,8 +1171,8 @@ summary, y_init
                 # level to within the root's ROOT_TIME_TOL; and none at a separation, where
                 # the normal forces vanish and with them the friction they bound)
                 if best_e != EV_SEP_G and best_e != EV_SEP_S:
-                    event_functions(p, ms, y, w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY], gw)
-                    summary[S_MARGIN] = min(summary[S_MARGIN], held_margin(gw, best_e))
+                    note_held_margin(p, ms, y, w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY], gw,
+                                     best_e, summary)
                 if best_e != EV_IMPACT and math.isfinite(w7[1]):
                     alpha = w7[1]  # (the solve of state_loads; an impact changes the pivot)
             trigger = -1
@@ -1247,7 +1248,9 @@ summary, y_init
                         # the constraint touched zero and held again as far as the selection
                         # looked: watched on at a shifted level (a force), off until clear of
                         # zero (a slip velocity), see shifted_level
-                        event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, gw, w7)
+                        if best_e == EV_G_STICK or best_e == EV_S_STICK or best_e == EV_UPLIFT:
+                            # (a force event: its level follows its value here)
+                            event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, gw, w7)
                         levels[best_e] = shifted_level(best_e, levels[best_e], gw[best_e])
                     else:
                         for e in range(N_EVENTS):

@@ -357,7 +357,7 @@ def kernel_summary(system, ax, ay, dt) -> np.ndarray:
 def fast_audit(args) -> int:
     """``--fast``: the kernel's constraint audit (and no solver error) over many runs."""
     t0 = time.perf_counter()
-    least, n_violating, n_fail = (np.inf, -1), 0, {}
+    least, n_violating, n_errors, n_fail = (np.inf, -1), 0, 0, {}
     mode_runs = np.zeros(8, dtype=int)
     bad = []
     jam_runs = 0
@@ -370,16 +370,18 @@ def fast_audit(args) -> int:
         jam_runs += summary[K.S_N_JAMS] > 0
         if margin < least[0]:
             least = (margin, i)
-        if not margin >= -FORCE_TOL - KERNEL_ROUNDING or failure == Failure.SOLVER_ERROR:
-            n_violating += 1
+        violating = not margin >= -FORCE_TOL - KERNEL_ROUNDING
+        n_violating += violating
+        n_errors += failure == Failure.SOLVER_ERROR
+        if violating or failure == Failure.SOLVER_ERROR:
             bad.append(f"case {i}: least margin {margin:.3e}, failure {failure}")
     print(f"seed {args.seed}, stratum {args.stratum}, kernel audit: {args.runs} runs in "
           f"{time.perf_counter() - t0:.0f} s; failures (code: runs) {n_fail}")
     print("runs entering modes 1..8: " + ", ".join(str(v) for v in mode_runs)
           + f"; runs with jams {jam_runs}")
     print(f"constraint audit: {n_violating} runs violating a held condition beyond FORCE_TOL "
-          f"= {FORCE_TOL:g} or failing with a solver error; least margin {least[0]:.3e} of "
-          f"the weight (case {least[1]})")
+          f"= {FORCE_TOL:g}; least margin {least[0]:.3e} of the weight (case {least[1]}); "
+          f"{n_errors} runs failing with a solver error")
     for line in bad:
         print("  " + line)
     return 1 if bad else 0
