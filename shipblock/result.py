@@ -8,7 +8,48 @@ from functools import cached_property
 
 import numpy as np
 
-from shipblock.modes import FAILURE_NAMES, MODE_DESCRIPTIONS, EventKind
+from shipblock.equations import I_TH_DD, I_XB_DD, I_XS_DD, N_SOLVE_OUT, solve_mode
+from shipblock.modes import FAILURE_NAMES, MODE_DESCRIPTIONS, MODE_FLAGS, EventKind
+
+#: A rate too small to change any force (its square is 0), whose sign gives the pivot.
+_PIVOT_RATE = np.nextafter(0.0, 1.0)
+
+
+def _with_pivot(mode, theta, theta_dot, v_b, v_s, system, ax, ay):
+    r"""``theta_dot`` with the pivot marked where the blocks rock from theta = theta_dot = 0.
+
+    The forces of a rocking mode depend on its pivot ``s``, which the histories give as the
+    sign of theta, or of theta_dot where theta is 0. At a sample where the blocks rock with
+    neither (a rocking phase starting at the sample, e.g. at t = 0), the pivot is the one on
+    which the rotation starts, :math:`s\ddot\theta > 0` (the mode selection admits a new
+    rocking only so; of the two pivots at most one can), with each slip direction at zero
+    velocity the one its acceleration takes. It is carried to the force computation as the sign
+    of ``_PIVOT_RATE``. Before 2026-11-26 it was taken as +1 whatever the direction (issue 32:
+    a ship friction utilisation of 4.55 reported at t = 0 where it was 0.64). Where neither
+    pivot starts the rotation (not met), +1 is kept.
+    """
+    rocking = MODE_FLAGS[np.clip(mode, 0, 8), 1] != 0
+    at_zero = rocking & (theta == 0.0) & (theta_dot == 0.0)
+    if not at_zero.any():
+        return theta_dot
+    out = np.array(theta_dot, dtype=float)
+    p = system.to_parameter_vector()
+    w = np.empty(N_SOLVE_OUT)
+    for k in np.flatnonzero(at_zero):
+        slip1, slip2 = int(MODE_FLAGS[mode[k], 0]), int(MODE_FLAGS[mode[k], 2])
+        starting = set()
+        for s in (1.0, -1.0):
+            for sig1 in ((np.sign(v_b[k]),) if v_b[k] != 0.0 else (1.0, -1.0)):
+                for sig2 in ((np.sign(v_s[k]),) if v_s[k] != 0.0 else (1.0, -1.0)):
+                    if (solve_mode(p, slip1, 1, slip2, s, sig1, sig2, 0.0, 0.0, ax[k],
+                                   system.g + ay[k], w)
+                            and s * w[I_TH_DD] > 0.0
+                            and (not slip1 or v_b[k] != 0.0 or sig1 * w[I_XB_DD] > 0.0)
+                            and (not slip2 or v_s[k] != 0.0 or sig2 * w[I_XS_DD] > 0.0)):
+                        starting.add(s)
+        if len(starting) == 1:
+            out[k] = starting.pop() * _PIVOT_RATE
+    return out
 
 
 @dataclass(frozen=True)
@@ -193,8 +234,10 @@ class SimulationResult:
         from shipblock.interface_forces import interface_forces
 
         ax, ay = self.ground_acceleration
-        return interface_forces(self.system, self.mode, self.theta, self.theta_dot, self.v_b,
-                                self.v_s, ax, ay)
+        return interface_forces(self.system, self.mode, self.theta,
+                                _with_pivot(self.mode, self.theta, self.theta_dot, self.v_b,
+                                            self.v_s, self.system, ax, ay),
+                                self.v_b, self.v_s, ax, ay)
 
     def to_dataset(self):
         """The result as an :class:`xarray.Dataset` with units and long names.

@@ -113,7 +113,7 @@ def test_kernel_choice_equals_exhaustive_ranking(seed):
             y[4] = rng.choice([0.4, -0.4])  # just after an impact
         a, ay = rng.normal() * 4.0, rng.normal() * 2.0
         trigger = int(rng.integers(-1, 3))
-        status = K.select_mode(p, y, ms, a, ay, trigger, w7, work)
+        status = K.select_mode(p, y, ms, a, ay, trigger, w7, work, 0.0, 0.0)
         want, consistent = reference_choice(system, y, a, ay, trigger)
         if status == 2:
             continue
@@ -144,7 +144,7 @@ def test_ship_lifting_off_is_a_separation():
     assert reference_ship_liftoff(system, y, a, ay)
     ms = np.zeros(6, dtype=np.int64)
     status = K.select_mode(system.to_parameter_vector(), y, ms, a, ay, 2, np.zeros(7),
-                           np.zeros(N_SPAN_WORK))
+                           np.zeros(N_SPAN_WORK), 0.0, 0.0)
     assert status == 2
     # the same state as a run's start: it separates at t = 0, without a warning
     import warnings
@@ -174,7 +174,7 @@ def test_nonrocking_candidates_use_the_response_cache():
     weight = (system.total_block_mass + system.ship_mass) * system.g
     scale = np.array([system.g] * 3 + [weight] * 4)
     for a, ay in [(0.5, 0.3), (-0.7, -1.0), (4.0, 0.0), (-4.0, 1.5)]:
-        status = K.select_mode(p, np.zeros(9), ms, a, ay, -1, w7, work)
+        status = K.select_mode(p, np.zeros(9), ms, a, ay, -1, w7, work, 0.0, 0.0)
         assert status == 0 and ms[1] == 0  # rest, or the blocks sliding: no rocking
         slip1, slip2, sig1, sig2 = int(ms[0]), int(ms[2]), float(ms[4]), float(ms[5])
         assert work[W_RESP_STATE + response_slot(slip1, sig1, slip2, sig2)] == 1.0

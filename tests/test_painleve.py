@@ -299,8 +299,9 @@ def test_random_painleve_states():
         p = system.to_parameter_vector()
         y0 = y.copy()
         work = np.zeros(N_SPAN_WORK)
-        first = K.select_mode(p, y, ms, a, ay, -1, w7, work)
-        status, loss, jammed, _ = K.resolve_mode(p, y, ms, a, ay, a, ay, -1, w7, work, Kw, first)
+        first = K.select_mode(p, y, ms, a, ay, -1, w7, work, 0.0, 0.0)
+        status, loss, jammed, _ = K.resolve_mode(p, y, ms, a, ay, a, ay, -1, w7, work, Kw, first,
+                                                 0.0, 0.0)
         if not jammed:
             continue
         assert status in (0, 2)

@@ -1,7 +1,7 @@
 """Running the dock-section model: :func:`simulate_section`, its result, and a batch entry point.
 
 The same shape as :func:`shipblock.simulate`: a system (:class:`DockSection`), a ground motion
-(a :class:`~shipblock.motion.GroundMotion`, or horizontal and vertical arrays with ``dt``) and
+(a :class:`~shipblock.records.motion.GroundMotion`, or horizontal and vertical arrays with ``dt``) and
 options; a result with histories at the samples, located events, the engineering demand
 parameters of every support line and of the ship, the failure (if any), the energy balance and
 :meth:`SectionResult.to_dataset`.
@@ -206,7 +206,7 @@ def simulate_section(section: DockSection, motion, vertical=None, dt: float | No
     ----------
     section : DockSection
     motion : GroundMotion or array_like
-        A :class:`~shipblock.motion.GroundMotion` (its horizontal, vertical and dt), or the
+        A :class:`~shipblock.records.motion.GroundMotion` (its horizontal, vertical and dt), or the
         horizontal acceleration [m/s^2] (positive to starboard) at ``k dt``.
     vertical : array_like, optional
         Vertical acceleration [m/s^2] (positive up), with an array ``motion``.

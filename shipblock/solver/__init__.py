@@ -287,6 +287,9 @@ def _summary_dict(summary: np.ndarray, system: ShipBlockSystem) -> dict:
     for m, name in enumerate(MODE_TIME_FIELDS):
         out[name] = values[K.S_MODE_TIME + m]
     out["peak_rotation_ratio"] = out["peak_rotation"] / system.critical_angle
+    # the audit of the constraints (issue 32; not a batch field): >= -FORCE_TOL when each held
+    # condition held to the tolerance at every accepted step, sample and event
+    out["least_constraint_margin"] = values[K.S_MARGIN]
     for name in PER_BLOCK_FIELDS:
         out[name] /= system.n_blocks
     out["uplift"] = bool(out["uplift"])

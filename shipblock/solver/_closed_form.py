@@ -49,7 +49,7 @@ from shipblock.equations import (
     solve_mode,
 )
 from shipblock.modes import MODE_NUMBER
-from shipblock.solver._events import event_functions, rearm
+from shipblock.solver._events import event_functions, note_held_margin, rearm
 from shipblock.solver._ground import ground_motion_at
 from shipblock.solver._history import store_sample
 from shipblock.solver._layout import (
@@ -108,12 +108,16 @@ FAST_BLOCK = 64
 def linear_root(l0, l1, h):
     """Time in [0, h] at which a linear function going from ``l0`` to ``l1`` turns negative.
 
-    ``inf`` if it ends non-negative; 0 if it starts on or below zero (the event is due now).
+    ``inf`` if it ends non-negative; 0 if it starts on or below zero and falls (the event is
+    due now); ``inf`` if it starts below zero and rises: a force event watched at a shifted
+    level whose function stood at or just below that level at the event that kept its mode
+    (the mode selection found the condition held, and it is recovering) does not fire again
+    at once (:func:`~shipblock.solver._events.shifted_level`).
     """
     if l1 >= 0.0:
         return NO_ROOT
     if l0 <= 0.0:
-        return 0.0
+        return 0.0 if l1 < l0 else NO_ROOT
     return h * l0 / (l0 - l1)
 
 
@@ -126,8 +130,6 @@ def min_linear_root(la0, la1, lb0, lb1, h):
     """
     if min(la1, lb1) >= 0.0:
         return NO_ROOT
-    if min(la0, lb0) <= 0.0:
-        return 0.0
     return min(linear_root(la0, la1, h), linear_root(lb0, lb1, h))
 
 
@@ -390,7 +392,7 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
     over the block's indices. The time is added at the end (:func:`add_repeated`).
 
     With ``loads`` the range of the scaled input over the samples passed is kept too, for
-    :func:`~shipblock.solver._load_peaks.note_span_extremes`: the fast blocks are checked
+    :func:`~shipblock.solver._running_peaks.note_span_extremes`: the fast blocks are checked
     against ``[lo, hi]`` cut to the range already covered (the span's ``[a_lo, a_hi]`` and the
     range ``[n_lo, n_hi]`` whose loads are noted: their hull, whose ends are all noted by the
     end of the span), and only a block that reaches beyond it is scanned for its least and
@@ -411,7 +413,7 @@ def skip_rest(ax, ay, has_ay, sh, sv, k, dt, time, grav, fx_a, fx_g, fy_a, fy_g,
         (:func:`held_interval` of rest; ``lo > hi`` for none, as with a vertical input).
     loads : bool
         Whether to keep the range of the input (only where
-        :func:`~shipblock.solver._load_peaks.folds_loads`: no vertical input).
+        :func:`~shipblock.solver._running_peaks.folds_loads`: no vertical input).
     a_lo, a_hi : float
         The span's range of scaled input so far [m/s^2].
     n_lo, n_hi : float
@@ -553,7 +555,7 @@ def mode_response_start(p, work, slip1, sig1, slip2, sig2):
 # inlined into the kernel's loop: a call passed some 75 machine words of arguments at every
 # event, a few per cent of a stick-slip record's time
 @njit(cache=True, error_model="numpy", _nrt=False, forceinline=True)
-def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs,
+def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, levels, peak_xb, peak_xs,
                     store, hist, modes, work, summary):
     """Advance a non-rocking mode sample by sample until an event or the end of the record.
 
@@ -569,8 +571,9 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         Current sample interval and time into it [s].
     dt, ax, ay, has_ay, sh, sv
         Record and scale factors as in :func:`shipblock.solver._kernel.run`.
-    armed : ndarray of bool
-        Events being watched; disarmed ones are re-armed once clear of zero.
+    levels : ndarray
+        The level below which each event function fires (0, shifted or -inf: see
+        :func:`~shipblock.solver._events.shifted_level`); restored to 0 once clear of zero.
     peak_xb, peak_xs : float
         Running peaks of |x_b| and |x_s| at the samples.
     store, hist, modes
@@ -586,12 +589,12 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         interval of :func:`held_interval`, set with its response vectors, and the range of
         input whose contact loads are noted.
     summary : ndarray, shape (N_SUMMARY,)
-        The run's summary. Where :func:`~shipblock.solver._load_peaks.folds_loads` (no
+        The run's summary. Where :func:`~shipblock.solver._running_peaks.folds_loads` (no
         vertical input), the span notes the contact loads of its start, its samples and its
         end itself: it keeps the least and greatest scaled input over them (two operations a
         sample; :func:`skip_rest` keeps them over a long rest) and notes the loads there on
-        leaving (:func:`~shipblock.solver._load_peaks.note_span_extremes`). Otherwise
-        :func:`~shipblock.solver._loads.span_loads`, which the kernel calls next (when
+        leaving (:func:`~shipblock.solver._running_peaks.note_span_extremes`). Otherwise
+        :func:`~shipblock.solver._force_sampling.span_loads`, which the kernel calls next (when
         ``work[W_FOLDED]`` is 0), scans them.
 
     Returns
@@ -639,7 +642,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
     a_lo = a_hi = a0
     all_armed = True
     for e in range(N_EVENTS):
-        if not armed[e]:
+        if levels[e] != 0.0:
             all_armed = False
     time_in_mode = 0.0  # accumulated here, added to the summary by the caller
     if not slip1 and not slip2 and all_armed and y[Y_VB] == 0.0 and y[Y_VS] == 0.0:
@@ -692,8 +695,9 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
         # quadratic and can also dip below zero inside. Only a suspect interval is searched.
         # The held conditions (normal forces, moment criterion, stick cones) need no check
         # inside [lo, hi]; the normal forces are then not computed at all.
-        suspect = not all_armed or not lo <= a1 <= hi and held_fails_at(
+        held_fails = not lo <= a1 <= hi and held_fails_at(
             slip1, slip2, a1, G1, fx_a, fx_g, fy_a, fy_g, Fx_a, Fx_g, Fy_a, Fy_g, mus1, mus2, B, H)
+        suspect = held_fails or not all_armed
         # a slipping interface: its slip may stop
         if slip1:
             suspect = suspect or slip_may_stop(sig1, vb0, ub0, ub1, h)
@@ -708,29 +712,33 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
             best_e = -1
             for ie in range(N_EVENTS):
                 e = EVENT_PRIORITY[ie]
-                # only the events a non-rocking mode can meet, and only armed ones
-                if not armed[e] or e in (EV_IMPACT, EV_OVERTURN) \
+                # only the events a non-rocking mode can meet, and not disarmed ones; each
+                # crosses its level (0 unless shifted)
+                level = levels[e]
+                if level == -math.inf or e in (EV_IMPACT, EV_OVERTURN) \
                         or (e == EV_G_STICK and slip1) or (e == EV_G_SLIP and not slip1) \
                         or (e == EV_S_STICK and slip2) or (e == EV_S_SLIP and not slip2):
                     continue
                 if e == EV_SEP_G:
-                    r = linear_root(fy0 * inv_w, fy1 * inv_w, h)
+                    r = linear_root(fy0 * inv_w - level, fy1 * inv_w - level, h)
                 elif e == EV_SEP_S:
-                    r = linear_root(Fy0 * inv_ws, Fy1 * inv_ws, h)
+                    r = linear_root(Fy0 * inv_ws - level, Fy1 * inv_ws - level, h)
                 elif e == EV_G_STICK:
-                    r = min_linear_root((mus1 * fy0 - fx0) * inv_w, (mus1 * fy1 - fx1) * inv_w,
-                                        (mus1 * fy0 + fx0) * inv_w, (mus1 * fy1 + fx1) * inv_w,
-                                        h)
+                    r = min_linear_root((mus1 * fy0 - fx0) * inv_w - level,
+                                        (mus1 * fy1 - fx1) * inv_w - level,
+                                        (mus1 * fy0 + fx0) * inv_w - level,
+                                        (mus1 * fy1 + fx1) * inv_w - level, h)
                 elif e == EV_S_STICK:
-                    r = min_linear_root((mus2 * Fy0 - Fx0) * inv_ws, (mus2 * Fy1 - Fx1) * inv_ws,
-                                        (mus2 * Fy0 + Fx0) * inv_ws, (mus2 * Fy1 + Fx1) * inv_ws,
-                                        h)
+                    r = min_linear_root((mus2 * Fy0 - Fx0) * inv_ws - level,
+                                        (mus2 * Fy1 - Fx1) * inv_ws - level,
+                                        (mus2 * Fy0 + Fx0) * inv_ws - level,
+                                        (mus2 * Fy1 + Fx1) * inv_ws - level, h)
                 elif e == EV_UPLIFT:
                     r = min_linear_root(
-                        (B * (fy0 + Fy0) - H * (fx0 + Fx0)) * inv_wr,
-                        (B * (fy1 + Fy1) - H * (fx1 + Fx1)) * inv_wr,
-                        (B * (fy0 + Fy0) + H * (fx0 + Fx0)) * inv_wr,
-                        (B * (fy1 + Fy1) + H * (fx1 + Fx1)) * inv_wr, h)
+                        (B * (fy0 + Fy0) - H * (fx0 + Fx0)) * inv_wr - level,
+                        (B * (fy1 + Fy1) - H * (fx1 + Fx1)) * inv_wr - level,
+                        (B * (fy0 + Fy0) + H * (fx0 + Fx0)) * inv_wr - level,
+                        (B * (fy1 + Fy1) + H * (fx1 + Fx1)) * inv_wr - level, h)
                 elif e == EV_G_SLIP:
                     r = quadratic_root(sig1 * vb0, sig1 * ub0, sig1 * (ub1 - ub0) / (2.0 * h), h)
                 else:  # EV_S_SLIP
@@ -739,10 +747,20 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
                 if r < best_h - 2.0 * ROOT_TIME_TOL:
                     best_h = r
                     best_e = e
-            if best_e >= 0:
+            # the run's least constraint margin (the audit, S_MARGIN): at the ends of the
+            # intervals the screen does not pass (it passes only those where every held
+            # condition holds), and up to the event
+            if best_e < 0:
+                if held_fails or not all_armed:
+                    note_held_margin(p, ms, y, fx1, fy1, Fx1, Fy1, g, np.int64(-1), summary)
+            else:
                 # advance to the event: the same polynomials, cut at best_h (u = best_h / h)
                 u = best_h / h
                 a_end = a0 + (a1 - a0) * u
+                if best_e != EV_SEP_G and best_e != EV_SEP_S:  # (as the kernel's events)
+                    note_held_margin(p, ms, y, fx0 + (fx1 - fx0) * u, fy0 + (fy1 - fy0) * u,
+                                     Fx0 + (Fx1 - Fx0) * u, Fy0 + (Fy1 - Fy0) * u, g, best_e,
+                                     summary)
                 y[Y_XB], y[Y_XS], y[Y_WIN], y[Y_DIS] = xb, xs, w_in, dis
                 y[Y_VB], y[Y_VS] = vb, vs
                 exact_update(y, best_h, ub0, ub0 + (ub1 - ub0) * u, us0, us0 + (us1 - us0) * u,
@@ -785,7 +803,7 @@ def nonrocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb
             if not all_armed:
                 event_functions(p, ms, y, fx1, fy_a * a1 + fy_g * G1, Fx1,
                                 Fy_a * a1 + Fy_g * G1, g)
-                all_armed = rearm(armed, g)
+                all_armed = rearm(levels, g)
             if store:
                 store_sample(p, ms, y, hist, modes, k, mode)
     y[Y_XB], y[Y_VB], y[Y_XS], y[Y_VS], y[Y_WIN], y[Y_DIS] = xb, vb, xs, vs, w_in, dis

@@ -28,8 +28,11 @@ from shipblock.solver._layout import (
     MS_SIG2,
     MS_SLIP1,
     MS_SLIP2,
+    FORCE_TOL,
+    LEVEL_GAP,
     N_EVENTS,
     REARM_TOL,
+    S_MARGIN,
     Y_TH,
     Y_VB,
     Y_VS,
@@ -38,18 +41,65 @@ from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R, P_TH
 
 
 @njit(cache=True, forceinline=True)
-def rearm(armed, g):
-    """Re-arm the disarmed events whose function ``g`` is clear of zero: True if all are armed.
+def rearm(levels, g):
+    """Restore the shifted or disarmed event levels whose function ``g`` is clear of zero: True
+    if every level is back at 0.
 
-    An event disarmed after a grazing contact is watched again once its function exceeds
-    ``REARM_TOL``.
+    Event ``e`` fires when its function falls below ``levels[e]``: 0 normally, between
+    ``-FORCE_TOL`` and 0 for a force event whose mode was selected again when it fired
+    (:func:`shifted_level`), ``-inf`` for a velocity event in that case. A level is restored to
+    0 once its function exceeds ``REARM_TOL``.
     """
     all_armed = True
     for e in range(N_EVENTS):
-        if not armed[e] and g[e] > REARM_TOL:
-            armed[e] = True
-        all_armed = all_armed and armed[e]
+        if levels[e] != 0.0 and g[e] > REARM_TOL:
+            levels[e] = 0.0
+        all_armed = all_armed and levels[e] == 0.0
     return all_armed
+
+
+@njit(cache=True, forceinline=True)
+def shifted_level(e, level, value):
+    """The level at which event ``e`` is watched after it fired at ``level`` (its function
+    then at ``value``) and the mode selection kept the mode: the event is shifted, not
+    switched off.
+
+    A force event (the friction cones, the blocks' moment criterion) is watched again halfway
+    from its level to ``-FORCE_TOL``, the tolerance of the mode selection's held conditions in
+    the units of the event functions (forces by the weights, moments by weight x R): a
+    constraint that merely touched zero stays watched, and one that goes on being violated
+    fires again before its violation exceeds the tolerance, when the mode selection, now
+    seeing a violation beyond half of it grow, releases it. The levels ``-FORCE_TOL/2``,
+    ``-3 FORCE_TOL/4``, ... tend to ``-FORCE_TOL``; the level is at least ``LEVEL_GAP`` below
+    the function's value, so that an event does not fire again at the same instant where the
+    levels have come within rounding of ``-FORCE_TOL`` (the selection computes the margin its
+    own way, and at the tolerance's edge the two may differ by some 1e-16): one more firing
+    then needs the function to fall by ``LEVEL_GAP``, and the selection releases the
+    constraint once its own margin is past the tolerance, so the function never goes past
+    ``-FORCE_TOL`` by more than rounding and a few ``LEVEL_GAP``. A velocity event (a slip
+    velocity brought to zero and moving on the same way) is disarmed (``-inf``) until clear of
+    zero, as before 2026-11-26; the other events never keep their mode.
+    """
+    if e == EV_G_STICK or e == EV_S_STICK or e == EV_UPLIFT:
+        return min(0.5 * (level - FORCE_TOL), value - LEVEL_GAP)
+    return -math.inf
+
+
+@njit(cache=True, forceinline=True)
+def held_margin(g, skip):
+    """The least of the event functions ``g`` of the conditions a mode holds: the stick cones,
+    the blocks' moment criterion and the normal forces (1 where none applies, as
+    :func:`event_functions` sets those that do not), leaving out event ``skip`` (-1: none).
+
+    Dimensionless like the event functions; at least ``-FORCE_TOL`` wherever the mode's
+    constraints hold to the tolerance of the mode selection. The kernel keeps its least value
+    over a run (``S_MARGIN``), the audit of the random campaign.
+    """
+    m = 1.0
+    for e in (EV_G_STICK, EV_S_STICK, EV_UPLIFT, EV_SEP_G, EV_SEP_S):
+        if e != skip and g[e] < m:
+            m = g[e]
+    return m
 
 
 @njit(cache=True, forceinline=True)
@@ -116,3 +166,26 @@ def stuck_rocking_clear(p, s, theta, fx, fy, Fx, Fy):
     """
     return (p[P_MUS1] * fy - abs(fx) >= 0.0 and p[P_MUS2] * Fy - abs(Fx) >= 0.0
             and fy >= 0.0 and Fy >= 0.0 and s * theta >= 0.0 and p[P_THC] - s * theta >= 0.0)
+
+
+@njit(cache=True, forceinline=True)
+def held_clear(p, ms, fx, fy, Fx, Fy):
+    """Whether every condition mode ``ms`` holds is met (margin >= 0) under the interface
+    forces ``fx, fy, Fx, Fy`` [N]: the signs of the numerators of :func:`event_functions`,
+    without its divisions, the screen of :func:`note_held_margin`."""
+    return ((ms[MS_SLIP1] != 0 or p[P_MUS1] * fy - abs(fx) >= 0.0)
+            and (ms[MS_SLIP2] != 0 or p[P_MUS2] * Fy - abs(Fx) >= 0.0)
+            and (ms[MS_ROCK] != 0 or p[P_B] * (fy + Fy) - p[P_H] * abs(fx + Fx) >= 0.0)
+            and fy >= 0.0 and Fy >= 0.0)
+
+
+@njit(cache=True, forceinline=True)
+def note_held_margin(p, ms, y, fx, fy, Fx, Fy, g, skip, summary):
+    """Lower the run's least constraint margin (``S_MARGIN``) by the held conditions of mode
+    ``ms`` under the interface forces ``fx, fy, Fx, Fy`` [N], leaving out event ``skip``
+    (-1: none); ``g`` is work for the event functions, computed only where a condition is not
+    clear of zero (:func:`held_clear`): a margin >= 0 cannot lower the least one."""
+    if not held_clear(p, ms, fx, fy, Fx, Fy):
+        event_functions(p, ms, y, fx, fy, Fx, Fy, g)
+        summary[S_MARGIN] = min(summary[S_MARGIN], held_margin(g, skip))
+

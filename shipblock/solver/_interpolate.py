@@ -208,3 +208,54 @@ def rotation_peak(peak, peak_time, th0, om0, al0, th1, om1, al1, h, t0, t1):
         peak = abs(th1)
         peak_time = t1
     return peak, peak_time
+
+
+@njit(cache=True, forceinline=True)
+def dip_possible(s, th0, al0, th1, al1, h):
+    """Whether the rotation may cross zero and come back inside a step whose ends are on the
+    pivot's side (``s th0 >= 0``, ``s th1 >= 0``): the screen of :func:`rotation_dip`.
+
+    A dip below zero between two ends at or above it bends the curve by more than the lower
+    end: :math:`\\min(s\\theta_0, s\\theta_1) < h^2 \\max|\\ddot\\theta| / 8`. The screen
+    takes :math:`\\max|\\ddot\\theta|` as twice the larger end value (the input is linear
+    within a step, so the angular acceleration varies little across it) and keeps a factor 4
+    in hand: only steps with :math:`\\min(s\\theta_0, s\\theta_1) \\le h^2\\max(|\\ddot\\theta_0|,
+    |\\ddot\\theta_1|)` are searched, the few near zero.
+    """
+    return min(s * th0, s * th1) <= h * h * max(abs(al0), abs(al1))
+
+
+@njit(cache=True, forceinline=False)
+def rotation_dip(s, th0, om0, al0, th1, om1, al1, h):
+    """A point inside a step where the rotation has crossed zero and come back: ``(u_dip,
+    u_top)`` on ``[0, 1]``, or ``(-1, -1)``.
+
+    Both ends are on the pivot's side (``s th >= 0``), so no check of the ends sees such a
+    pair of crossings (issue 32: rocking of 1e-9 to 1e-8 rad, impacts 0.1 ms apart inside one
+    step at the default ``atol``). The minima of :math:`s\\,p(u)` for the step's quintic
+    Hermite interpolant are the roots of its derivative where it turns from falling to
+    rising, found by sampling the derivative at ``u = k / 8`` and refining each sign change
+    (:func:`bracketed_root`); ``u_dip`` is the first with :math:`s\\,p < 0`, ``u_top`` the last
+    point before it with :math:`s\\,p > 0` (0, or the interpolant's maximum before the dip when
+    the step starts at zero, just after an impact).
+    """
+    c0, c1, c2, c3, c4, c5 = quintic_hermite(s * th0, s * om0, s * al0, s * th1, s * om1,
+                                             s * al1, h)
+    _, d_prev = quintic_and_slope(c0, c1, c2, c3, c4, c5, 0.0)
+    u_prev = 0.0
+    u_top = 0.0 if c0 > 0.0 else -1.0
+    for k in range(1, 9):
+        u = k / 8.0
+        _, d = quintic_and_slope(c0, c1, c2, c3, c4, c5, u)
+        if d_prev > 0.0 >= d:
+            # a maximum: the top before a dip (kept if it is above zero)
+            r = bracketed_root(c0, c1, c2, c3, c4, c5, u_prev, u, np.bool_(True))
+            if r > 0.0 and poly5(c0, c1, c2, c3, c4, c5, r) > 0.0:
+                u_top = r
+        if d_prev < 0.0 <= d:
+            r = bracketed_root(c0, c1, c2, c3, c4, c5, u_prev, u, np.bool_(True))
+            if r > 0.0 and poly5(c0, c1, c2, c3, c4, c5, r) < 0.0 and u_top >= 0.0:
+                return r, u_top
+        d_prev = d
+        u_prev = u
+    return -1.0, -1.0

@@ -56,13 +56,23 @@ from shipblock.impact import apply_impact, apply_jam
 from shipblock.modes import MODE_NUMBER, EventKind, Failure
 from shipblock.solver._closed_form import mode_response_start, nonrocking_span
 from shipblock.solver._dopri import DP_A, DP_C, DP_E, DP_ERROR_ORDER
-from shipblock.solver._events import event_functions, impact_return_time, rearm, rotation_event
-from shipblock.solver._ground import ground_motion_at
+from shipblock.solver._events import (
+    event_functions,
+    held_margin,
+    impact_return_time,
+    note_held_margin,
+    rearm,
+    rotation_event,
+    shifted_level,
+)
+from shipblock.solver._ground import ground_motion_at, one_sided_motion
 from shipblock.solver._history import store_sample
 from shipblock.solver._interpolate import (
     bracketed_root,
+    dip_possible,
     hermite_extremum,
     quintic_hermite,
+    rotation_dip,
     rotation_peak,
 )
 from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrappers)
@@ -107,6 +117,7 @@ from shipblock.solver._layout import (  # noqa: F401  (re-exported for the wrapp
     S_FAILURE,
     S_FAILURE_TIME,
     S_IMPACT_LOSS,
+    S_MARGIN,
     S_MODE_TIME,
     S_N_EVENTS,
     S_N_IMPACTS,
@@ -308,18 +319,20 @@ def event_after(e, p, ms, y0, k, tau, h, dt, ax, ay, has_ay, sh, sv, y1, stages,
 
 
 @njit(cache=True, forceinline=False, _nrt=False)
-def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has_ay, sh, sv,
-                y1, stages, ytmp, w7, g):
-    """Illinois iteration for the step length at which event ``e`` crosses zero.
+def locate_root(e, level, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has_ay,
+                sh, sv, y1, stages, ytmp, w7, g):
+    """Illinois iteration for the step length at which event ``e`` crosses its ``level`` (0,
+    or the shifted level of :func:`~shipblock.solver._events.shifted_level`).
 
-    ``g_lo >= 0 > g_hi``. ``guess`` (ignored unless inside the bracket) is a first estimate of
-    the root, e.g. from an interpolant: it and a point ``GUESS_PROBE`` beyond it are tried
-    first, which usually leaves a bracket a few ``ROOT_TIME_TOL`` wide. Returns the violated
+    ``g_lo >= 0 > g_hi``, both relative to ``level``. ``guess`` (ignored unless inside the
+    bracket) is a first estimate of the root, e.g. from an interpolant: it and a point
+    ``GUESS_PROBE`` beyond it are tried first, which usually leaves a bracket a few
+    ``ROOT_TIME_TOL`` wide. Returns the violated
     end of the final bracket (width <= ROOT_TIME_TOL), so the event has just happened there.
     """
     if lo < guess < hi:
         gm = event_after(e, p, ms, y0, k, tau, guess, dt, ax, ay, has_ay, sh, sv,
-                         y1, stages, ytmp, w7, g)
+                         y1, stages, ytmp, w7, g) - level
         if gm < 0.0:
             hi, g_hi = guess, gm
             probe = guess - GUESS_PROBE
@@ -328,7 +341,7 @@ def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has
             probe = guess + GUESS_PROBE
         if lo < probe < hi:
             gm = event_after(e, p, ms, y0, k, tau, probe, dt, ax, ay, has_ay, sh, sv,
-                             y1, stages, ytmp, w7, g)
+                             y1, stages, ytmp, w7, g) - level
             if gm < 0.0:
                 hi, g_hi = probe, gm
             else:
@@ -344,7 +357,7 @@ def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has
         if not (lo + 0.01 * width < mid < hi - 0.01 * width):
             mid = 0.5 * (lo + hi)
         gm = event_after(e, p, ms, y0, k, tau, mid, dt, ax, ay, has_ay, sh, sv,
-                         y1, stages, ytmp, w7, g)
+                         y1, stages, ytmp, w7, g) - level
         if gm < 0.0:
             hi, g_hi = mid, gm
             if side == -1:
@@ -356,6 +369,45 @@ def locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y0, k, tau, dt, ax, ay, has
                 g_hi *= 0.5
             side = 1
     return hi
+
+
+@njit(cache=True, forceinline=False, _nrt=False)
+def first_before_impact(t_imp, p, ms, y0, k, tau, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp,
+                        w7, g, g0, levels):
+    """The first event of a step that holds an impact at ``t_imp``: ``(time, event)``.
+
+    The events of a step are found from its end, but past an impact the mode's equations run
+    on with the pivot on the wrong corner, so a condition crossed before the impact and met
+    again by the end of the step went unseen (until 2026-11-26; found by the constraint audit
+    of the random campaign, a stick cone violated by up to 1 % of the weight at the impact).
+    The event functions are evaluated at the impact (one step of ``t_imp`` from ``y0``,
+    whose event functions are ``g0``), and any below its level there is located before it;
+    the earliest is returned, or the impact.
+    """
+    best_h = t_imp
+    best_e = np.int64(EV_IMPACT)
+    event_after(np.int64(EV_SEP_G), p, ms, y0, k, tau, t_imp, dt, ax, ay, has_ay, sh, sv, y1,
+                stages, ytmp, w7, g)
+    below = 0  # (a bit per event below its level at the impact; g is work of the root search)
+    for e in range(N_EVENTS):
+        level = levels[e]
+        if (e != EV_IMPACT and e != EV_OVERTURN and level != -np.inf and g[e] < level
+                and g0[e] > level):
+            below |= 1 << e
+    if below == 0:
+        return best_h, best_e
+    for ie in range(N_EVENTS):
+        e = EVENT_PRIORITY[ie]
+        if below & (1 << e):
+            level = levels[e]
+            g_hi = event_after(e, p, ms, y0, k, tau, t_imp, dt, ax, ay, has_ay, sh, sv, y1,
+                               stages, ytmp, w7, g) - level
+            root = locate_root(e, level, 0.0, g0[e] - level, t_imp, g_hi, -1.0, p, ms, y0, k,
+                               tau, dt, ax, ay, has_ay, sh, sv, y1, stages, ytmp, w7, g)
+            if root < best_h - 2.0 * ROOT_TIME_TOL:
+                best_h = root
+                best_e = e
+    return best_h, best_e
 
 
 @njit(cache=True, forceinline=True)
@@ -457,15 +509,17 @@ CANDIDATE_KEYS, CANDIDATE_COUNTS = _candidate_order()
 
 
 @njit(cache=True, forceinline=False, _nrt=False)
-def select_mode(p, y, ms, a, b, trigger, w7, work):
-    """Choose the next mode among the candidates consistent with the velocities.
+def select_mode(p, y, ms, a, b, trigger, w7, work, lead, alpha):
+    r"""Choose the next mode among the candidates consistent with the velocities.
 
     Candidates: an interface with a nonzero slip velocity keeps slipping that way; one at zero
     velocity may stick or start slipping either way; a block with theta != 0 (or theta_dot != 0
     after an impact) rocks on the pivot given by that sign; one at rest may stay or start rocking
-    on either corner. Each candidate is evaluated ONE_SIDED_DT after the event and is consistent
-    when stick forces lie inside their static friction cones, the block-rest moment criterion
-    holds, new motions accelerate in their assumed direction and both normal forces are positive.
+    on either corner. Each candidate is evaluated ONE_SIDED_DT after the event (the ground input
+    ``a``, ``b`` there; a rotation ``theta != 0`` advanced along the motion by ``lead``, see
+    below) and is consistent when stick forces lie inside their static friction cones, the
+    block-rest moment criterion holds, new motions accelerate in their assumed direction and
+    both normal forces are positive.
     Among consistent candidates the one with the fewest new motions wins; ties go to the one
     releasing ``trigger`` (0 ground, 1 rocking, 2 ship), then to the lower paper mode number.
     If none is consistent, the system separates when every candidate has a non-positive normal
@@ -498,6 +552,18 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
         array argument as several machine words, and this runs at every event).
     trigger : int
         Interface whose event this is: 0 ground, 1 rocking, 2 ship, -1 none.
+    lead, alpha : float
+        The rocking candidates are evaluated at the rotation the motion reaches ``lead`` [s]
+        after the event, :math:`\theta + \dot\theta\,\ell + \alpha\ell^2/2` and
+        :math:`\dot\theta + \alpha\ell`, with ``alpha`` the angular acceleration of the
+        mode before the event [rad/s^2] (the kernel passes ``ONE_SIDED_DT``, or
+        ``ONE_SIDED_WIDE`` with the wider input, after an event in a rocking mode other than
+        an impact; 0 otherwise). With the state frozen at the event, a constraint crossed by
+        the rotation itself (the ship's friction in free rocking, driven by
+        :math:`\ddot\theta` and :math:`\dot\theta^2`) looked as held as at the crossing, and
+        the mode was kept past it (issue 32). The candidates' interface options are those of
+        the state at the event; a rotation that would reach zero within ``lead`` is not
+        advanced.
     w7 : ndarray, shape (N_SOLVE_OUT,)
         Work array: a candidate's :func:`~shipblock.equations.solve_mode` output.
     work : ndarray, shape (N_SPAN_WORK,)
@@ -519,6 +585,11 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
     acc_tol = ACC_TOL * p[P_G]
     vb, th, om, vs = y[Y_VB], y[Y_TH], y[Y_OM], y[Y_VS]
     rot = th if th != 0.0 else om
+    # the rotation along the motion, ONE_SIDED_DT on (not past zero: an impact is an event)
+    th_on = th + lead * (om + 0.5 * alpha * lead)
+    om_on = om + alpha * lead
+    if not th_on * th > 0.0:
+        th_on, om_on = th, om
     all_separate = True
     case = (4 if vb != 0.0 else 0) + (2 if rot != 0.0 else 0) + (1 if vs != 0.0 else 0)
     order = CANDIDATE_KEYS[case, trigger + 1]
@@ -534,16 +605,17 @@ def select_mode(p, y, ms, a, b, trigger, w7, work):
             for i in range(N_SOLVE_OUT):
                 w7[i] = work[start + i] * a + work[start + N_SOLVE_OUT + i] * G
         else:
-            c, sn = pivot_geometry(p, th, float(s), rock)
+            c, sn = pivot_geometry(p, th_on, float(s), rock)
             if slip1 == 0 and slip2 == 0:
                 # mode 3 (both interfaces held, so no slip velocities): its reduced form, the
                 # general equations to rounding (tests/test_stuck_rocking.py), after every impact
-                al, _ = stuck_rocking_rates(p, stuck_rocking_gain(p), c, sn, float(s), om, a, b)
-                stuck_forces_into(p, float(s), c, sn, om, al, a, b, w7)
+                al, _ = stuck_rocking_rates(p, stuck_rocking_gain(p), c, sn, float(s), om_on, a,
+                                            b)
+                stuck_forces_into(p, float(s), c, sn, om_on, al, a, b, w7)
             # solve_mode without its wrapper's call: this runs for one to three candidates per
             # event
             elif not solve_mode_at(p, slip1, rock, slip2, float(s), float(sig1), float(sig2), c,
-                                   sn, om, a, G, w7):
+                                   sn, om_on, a, G, w7):
                 continue
         fx, fy, Fx, Fy = w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY]
         if fy <= 0.0 or Fy <= 0.0:
@@ -646,7 +718,8 @@ def ship_lifts_off(p, y, a, G, w7):
 
 
 @njit(cache=True, forceinline=False, _nrt=False)
-def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K, status):
+def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K, status, lead_wide,
+                 alpha):
     """What follows :func:`select_mode` at ``(a, b)`` when it chose no mode: a jam of a slipping
     interface when no mode is consistent.
 
@@ -666,10 +739,12 @@ def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K, status):
     consistent (impulses beyond a friction cone: not met in random testing).
 
     Before any of this, a selection with none consistent is repeated with the ground input
-    ``(a_wide, b_wide)`` a little later (``ONE_SIDED_WIDE``): where a constraint is crossed at
-    a slow rate, its violation ``ONE_SIDED_DT`` after the event can exceed ``FORCE_TOL`` while
-    the new motion's push is still below ``ACC_TOL`` (the two tolerances are in different
-    units), and neither the held nor the released state passes.
+    ``(a_wide, b_wide)`` a little later (``ONE_SIDED_WIDE``, and the rotation advanced by
+    ``lead_wide`` with the angular acceleration ``alpha``, as in :func:`select_mode`): where a
+    constraint is crossed at a slow rate, its violation ``ONE_SIDED_DT`` after the event can
+    exceed ``FORCE_TOL`` while the new motion's push is still below ``ACC_TOL`` (the two
+    tolerances are in different units), and neither the held nor the released state passes.
+    The selections after a jam take the state as it is (the jam changed the velocities).
 
     Returns
     -------
@@ -685,7 +760,8 @@ def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K, status):
     """
     if status == 0:
         return 0, 0.0, 0, mode_number(ms)
-    if status == 1 and select_mode(p, y, ms, a_wide, b_wide, trigger, w7, work) == 0:
+    if status == 1 and select_mode(p, y, ms, a_wide, b_wide, trigger, w7, work, lead_wide,
+                                   alpha) == 0:
         return 0, 0.0, 0, mode_number(ms)
     vb, om, vs = y[Y_VB], y[Y_OM], y[Y_VS]
     rot = y[Y_TH] if y[Y_TH] != 0.0 else om
@@ -704,7 +780,7 @@ def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K, status):
             continue
         y[Y_VB], y[Y_OM], y[Y_VS] = vb, om, vs
         loss, admissible = apply_jam(p, jam & 1 != 0, jam & 2 != 0, y, K)
-        status = select_mode(p, y, ms, a, b, trigger, w7, work)
+        status = select_mode(p, y, ms, a, b, trigger, w7, work, 0.0, 0.0)
         if status == 0 and admissible:
             return 0, loss, jam, jam_from
         if status == 2 and admissible and sep_jam == 0:
@@ -716,7 +792,7 @@ def resolve_mode(p, y, ms, a, b, a_wide, b_wide, trigger, w7, work, K, status):
     if jam == 0:
         return 1, 0.0, 0, jam_from
     loss, _ = apply_jam(p, jam & 1 != 0, jam & 2 != 0, y, K)
-    status = select_mode(p, y, ms, a, b, trigger, w7, work)
+    status = select_mode(p, y, ms, a, b, trigger, w7, work, 0.0, 0.0)
     return status, loss, jam, jam_from
 
 
@@ -787,7 +863,7 @@ def run(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, 
 @njit(cache=True, forceinline=False, error_model="numpy", _nrt=False)
 def integrate(p_vec, ax, ay, has_ay, sh, sv, dt, rtol, atol, zeno_omega, store, hist, modes,
               ev_t, ev_kft, summary, y_init, y, y1, yr, ytmp, f_end, stages, w7, w7b, K, g0, g1,
-              gw, span_work, armed, ms):
+              gw, span_work, levels, ms):
     """The integration of one case of :func:`run_cases`, in work arrays allocated there.
 
     Compiled without reference counting: numba would otherwise update the counts of the work
@@ -813,8 +889,9 @@ summary, y_init
     span_work : ndarray, shape (N_SPAN_WORK,)
         Work of the closed-form spans, zero on entry; mode selection shares its response
         vectors.
-    armed : ndarray of bool, shape (N_EVENTS,)
-        Work: which events may fire (all True on entry).
+    levels : ndarray, shape (N_EVENTS,)
+        Work: the level below which each event function fires (all 0 on entry; see
+        :func:`~shipblock.solver._events.shifted_level`).
     ms : ndarray of int, shape (6,)
         Work: the mode state.
     """
@@ -825,6 +902,7 @@ summary, y_init
     n_ev = 0
     for i in range(N_SUMMARY):
         summary[i] = 0.0
+    summary[S_MARGIN] = 1.0  # (the least margin of the held conditions: none yet)
     impact_loss = 0.0
     failure = 0
     failure_time = np.nan
@@ -846,7 +924,8 @@ summary, y_init
     a_wide, b_wide = ground_motion_at(ax, ay, has_ay, sh, sv, k, ONE_SIDED_WIDE, dt)
     status, jam_loss, jammed, jam_from = resolve_mode(
         p_vec, y, ms, a_next, b_next, a_wide, b_wide, np.int64(-1), w7, span_work, K,
-        select_mode(p_vec, y, ms, a_next, b_next, np.int64(-1), w7, span_work))
+        select_mode(p_vec, y, ms, a_next, b_next, np.int64(-1), w7, span_work, 0.0, 0.0), 0.0,
+        0.0)
     if status == 2:
         failure = Failure.SEPARATION
         failure_time = 0.0
@@ -896,7 +975,7 @@ summary, y_init
             tau_before = tau
             span_impact = False
             k, tau, best_e, span_time, peak_xb, peak_xs = nonrocking_span(
-                p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, armed, peak_xb, peak_xs, store,
+                p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, levels, peak_xb, peak_xs, store,
                 hist, modes, span_work, summary)
             if best_e != -2:
                 summary[S_MODE_TIME + mode_number(ms) - 1] += span_time
@@ -919,7 +998,7 @@ summary, y_init
                 # nothing happens, or up to an impact
                 k_before = k
                 k, tau, span_impact, span_time, peak_th, peak_th_time = stuck_rocking_span(
-                    p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol, armed, g0, g1,
+                    p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol, levels, g0, g1,
                     peak_th, peak_th_time, store, hist, modes, mode_number(ms), summary)
                 if span_time > 0.0:
                     summary[S_MODE_TIME + mode_number(ms) - 1] += span_time
@@ -975,16 +1054,20 @@ summary, y_init
                 best_e = -1
                 for ie in range(N_EVENTS):
                     e = EVENT_PRIORITY[ie]
-                    if not armed[e]:
+                    level = levels[e]  # 0, or shifted (a force event), or -inf (disarmed)
+                    if level == -np.inf:
                         continue
                     lo = 0.0
-                    g_lo = g0[e]
+                    g_lo = g0[e] - level
                     hi = h
-                    g_hi = g1[e]
+                    g_hi = g1[e] - level
                     fired = False
-                    if g1[e] < 0.0:
+                    if g_hi < 0.0 and (g_lo > 0.0 or has_slope(e) or g_hi < g_lo):
+                        # (a force event that starts at or below its level fires only if it
+                        # falls further: one at a shifted level whose mode was kept, recovering,
+                        # does not fire again at once; see linear_root)
                         fired = True
-                        if g0[e] <= 0.0:
+                        if g_lo <= 0.0:
                             # started on the boundary: look for the interior maximum first
                             g_lo = 0.0
                             if has_slope(e):
@@ -1009,6 +1092,23 @@ summary, y_init
                                     fired = True
                                     hi = u * h
                                     g_hi = gm
+                    if (e == EV_IMPACT and not fired and g0[e] >= 0.0
+                            and dip_possible(float(ms[MS_S]), y[Y_TH], al0, y1[Y_TH], al1, h)):
+                        # both ends on the pivot's side: a pair of crossings inside the step
+                        # (out and back, or back and out), read off the rotation's interpolant
+                        u, u_top = rotation_dip(float(ms[MS_S]), y[Y_TH], y[Y_OM], al0,
+                                                y1[Y_TH], y1[Y_OM], al1, h)
+                        if u > 0.0:
+                            gm = event_after(e, p, ms, y, k, tau, u * h, dt, ax, ay, has_ay, sh,
+                                             sv, yr, stages, ytmp, w7, gw)
+                            g_top = g0[e]
+                            if u_top > 0.0:
+                                g_top = event_after(e, p, ms, y, k, tau, u_top * h, dt, ax, ay,
+                                                    has_ay, sh, sv, yr, stages, ytmp, w7, gw)
+                            if gm < 0.0 and g_top > 0.0:
+                                fired = True
+                                lo, g_lo = u_top * h, g_top
+                                hi, g_hi = u * h, gm
                     if fired:
                         if g_lo > 0.0:
                             guess = -1.0
@@ -1019,17 +1119,23 @@ summary, y_init
                                 u = bracketed_root(c0, c1, c2, c3, c4, c5, lo / h, hi / h, np.bool_(False))
                                 if u >= 0.0:
                                     guess = u * h
-                            root = locate_root(e, lo, g_lo, hi, g_hi, guess, p, ms, y, k, tau, dt,
-                                               ax, ay, has_ay, sh, sv, yr, stages, ytmp, w7, gw)
+                            root = locate_root(e, level, lo, g_lo, hi, g_hi, guess, p, ms, y, k,
+                                               tau, dt, ax, ay, has_ay, sh, sv, yr, stages, ytmp,
+                                               w7, gw)
                         else:
                             root = lo
                         # a later-priority event wins only if it is clearly earlier
                         if root < best_h - 2.0 * ROOT_TIME_TOL:
                             best_h = root
                             best_e = e
+                if best_e == EV_IMPACT:
+                    best_h, best_e = first_before_impact(
+                        best_h, p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, yr, stages, ytmp,
+                        w7, gw, g0, levels)
                 if best_e < 0:
                     # accept the whole step (w7b: the forces at its end)
                     note_loads(p, 1, w7b[I_FX], w7b[I_FY], w7b[I_SFX], w7b[I_SFY], summary)
+                    summary[S_MARGIN] = min(summary[S_MARGIN], held_margin(g1, np.int64(-1)))
                     peak_th, peak_th_time = rotation_peak(
                         peak_th, peak_th_time, y[Y_TH], y[Y_OM], al0, y1[Y_TH], y1[Y_OM], al1, h,
                         k * dt + tau, k * dt + (tau + h))
@@ -1039,7 +1145,7 @@ summary, y_init
                     fsal = True
                     for e in range(N_EVENTS):
                         g0[e] = g1[e]
-                    rearm(armed, g1)
+                    rearm(levels, g1)
                     summary[S_MODE_TIME + mode_number(ms) - 1] += h
                     tau += h
                     if h < remaining:
@@ -1057,9 +1163,18 @@ summary, y_init
             fsal = False
             t_now = k * dt + tau
             from_mode = mode_number(ms)
+            alpha = 0.0  # the angular acceleration before the event, if it rocked
             if ms[MS_ROCK]:
                 # (a non-rocking mode's forces here are the end of its span, noted by span_loads)
                 state_loads(p_vec, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, w7, summary)
+                # the conditions the mode held up to the event (but the event's own, at its
+                # level to within the root's ROOT_TIME_TOL; and none at a separation, where
+                # the normal forces vanish and with them the friction they bound)
+                if best_e != EV_SEP_G and best_e != EV_SEP_S:
+                    note_held_margin(p, ms, y, w7[I_FX], w7[I_FY], w7[I_SFX], w7[I_SFY], gw,
+                                     best_e, summary)
+                if best_e != EV_IMPACT and math.isfinite(w7[1]):
+                    alpha = w7[1]  # (the solve of state_loads; an impact changes the pivot)
             trigger = -1
             kind = EventKind.START
             jammed = 0
@@ -1099,16 +1214,20 @@ summary, y_init
             jam_from = from_mode
             if failure == 0:
                 old0, old1, old2, old3, old4, old5 = ms[0], ms[1], ms[2], ms[3], ms[4], ms[5]
-                a_next, b_next = ground_motion_at(ax, ay, has_ay, sh, sv, k, tau + ONE_SIDED_DT,
+                # the input's one-sided limit: on the line of this sample interval
+                a_next, b_next = one_sided_motion(ax, ay, has_ay, sh, sv, k, tau, ONE_SIDED_DT,
                                                   dt)
-                status = select_mode(p_vec, y, ms, a_next, b_next, trigger, w7, span_work)
+                # the rotation along the motion too, but for an impact (its pivot is new)
+                lead = ONE_SIDED_DT if best_e != EV_IMPACT else 0.0
+                status = select_mode(p_vec, y, ms, a_next, b_next, trigger, w7, span_work, lead,
+                                     alpha)
                 jam_loss = 0.0
                 if status != 0:
-                    a_wide, b_wide = ground_motion_at(ax, ay, has_ay, sh, sv, k,
-                                                      tau + ONE_SIDED_WIDE, dt)
+                    a_wide, b_wide = one_sided_motion(ax, ay, has_ay, sh, sv, k, tau,
+                                                      ONE_SIDED_WIDE, dt)
                     status, jam_loss, jammed, jam_from = resolve_mode(
                         p_vec, y, ms, a_next, b_next, a_wide, b_wide, trigger, w7, span_work, K,
-                        status)
+                        status, ONE_SIDED_WIDE if best_e != EV_IMPACT else 0.0, alpha)
                 if jammed:
                     # the jam's loss is booked with the impacts' (a tangential impact)
                     n_jams += 1
@@ -1126,11 +1245,16 @@ summary, y_init
                     same = (old0 == ms[0] and old1 == ms[1] and old2 == ms[2]
                             and old3 == ms[3] and old4 == ms[4] and old5 == ms[5])
                     if same and best_e != EV_IMPACT and not jammed:
-                        # grazing contact: the constraint touched zero and holds again
-                        armed[best_e] = False
+                        # the constraint touched zero and held again as far as the selection
+                        # looked: watched on at a shifted level (a force), off until clear of
+                        # zero (a slip velocity), see shifted_level
+                        if best_e == EV_G_STICK or best_e == EV_S_STICK or best_e == EV_UPLIFT:
+                            # (a force event: its level follows its value here)
+                            event_values(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, gw, w7)
+                        levels[best_e] = shifted_level(best_e, levels[best_e], gw[best_e])
                     else:
                         for e in range(N_EVENTS):
-                            armed[e] = True
+                            levels[e] = 0.0
                     if ms[MS_ROCK]:
                         uplift = 1
                     if ms[MS_ROCK]:
@@ -1218,7 +1342,7 @@ summary, y_init
 @njit(cache=True, forceinline=False, nogil=True, _nrt=False)
 def run_cases(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_params, case_sh,
               case_sv, rtol, atol, zeno_omega, next_case, summaries, store, hist, modes, ev_t,
-              ev_kft, y_init, vectors, stages, w7, K, g, span_work, armed, ms):
+              ev_kft, y_init, vectors, stages, w7, K, g, span_work, levels, ms):
     """Run cases until none is left; each case is (record, parameter row, H scale, V scale).
 
     The one compiled entry point of the solver: :func:`run` (one record, with its histories)
@@ -1256,7 +1380,7 @@ def run_cases(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_param
         empty arrays otherwise).
     y_init : ndarray, shape (6,)
         Initial state of every case.
-    vectors, stages, w7, K, g, span_work, armed, ms : ndarray
+    vectors, stages, w7, K, g, span_work, levels, ms : ndarray
         Work arrays of :func:`integrate`, as :func:`new_work` allocates them, one set per
         calling thread.
     """
@@ -1272,10 +1396,10 @@ def run_cases(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_param
         if c >= n_cases:
             break
         if last_params >= 0:
-            # every case starts from the work arrays as allocated (zeros, all events armed),
+            # every case starts from the work arrays as allocated (zeros, every event level 0),
             # but for the non-rocking modes' response vectors, kept from the case before when
             # it had the same parameters (they depend on nothing else)
-            _reset_work(vectors, stages, w7, K, g, span_work, armed, ms,
+            _reset_work(vectors, stages, w7, K, g, span_work, levels, ms,
                         case_params[c] == last_params)
         last_params = case_params[c]
         r = case_record[c]
@@ -1284,14 +1408,14 @@ def run_cases(params, acc_h, acc_v, offsets, dts, has_v, case_record, case_param
         integrate(params[case_params[c]], acc_h[a0:a1], acc_v[a0:a1], has_v[r], case_sh[c],
                   case_sv[c], dts[r], rtol, atol, zeno_omega, store, hist, modes, ev_t, ev_kft,
                   summaries[c], y_init, y, y1, yr, ytmp, f_end, stages, w7a, w7b, K, g0, g1, gw,
-                  span_work, armed, ms)
+                  span_work, levels, ms)
 
 
 def new_work() -> tuple:
-    """A set of work arrays for one thread's :func:`run_cases`: zeros, all events armed."""
+    """A set of work arrays for one thread's :func:`run_cases`: zeros (every event level 0)."""
     return (np.zeros((5, N_STATE)), np.zeros((7, N_STATE)), np.zeros((2, N_SOLVE_OUT)),
             np.zeros((3, 3)), np.zeros((3, N_EVENTS)), np.zeros(N_SPAN_WORK),
-            np.ones(N_EVENTS, dtype=np.bool_), np.zeros(6, dtype=np.int64))
+            np.zeros(N_EVENTS), np.zeros(6, dtype=np.int64))
 
 
 def no_histories():
@@ -1301,7 +1425,7 @@ def no_histories():
 
 
 @njit(cache=True, forceinline=True, _nrt=False)
-def _reset_work(vectors, stages, w7, K, g, span_work, armed, ms, keep_responses):
+def _reset_work(vectors, stages, w7, K, g, span_work, levels, ms, keep_responses):
     """The work arrays of :func:`run_cases` back to their state as allocated; with
     ``keep_responses`` (the next case has the same parameters) all but the closed-form spans'
     solutions that depend on the parameters alone: the non-rocking modes' response vectors,
@@ -1324,7 +1448,7 @@ def _reset_work(vectors, stages, w7, K, g, span_work, armed, ms, keep_responses)
     else:
         for i in range(span_work.shape[0]):
             span_work[i] = 0.0
-    for i in range(armed.shape[0]):
-        armed[i] = True
+    for i in range(levels.shape[0]):
+        levels[i] = 0.0
     for i in range(ms.shape[0]):
         ms[i] = 0

@@ -66,7 +66,16 @@ S_PEAK_SFX = 28  # blocks on ship, |friction|
 S_PEAK_UTIL_G = 29  # |fx| / (mu_s1 fy)
 S_PEAK_UTIL_S = 30  # |Fx| / (mu_s2 Fy)
 S_PEAK_CORNER = 31  # fy while the blocks rock (on their pivot corners)
-N_SUMMARY = 32
+# The least margin of the conditions the mode holds (stick cones, the blocks' moment criterion,
+# normal forces: EV_G_STICK, EV_S_STICK, EV_UPLIFT, EV_SEP_G, EV_SEP_S where they apply) over the
+# ends of the run's accepted steps and sample intervals and up to each event (the event's own
+# function, at its level there, left out; and none up to a separation) [-], see
+# shipblock.solver._events.held_margin. The mode an event enters is judged by the mode
+# selection ONE_SIDED_DT after it. At least -FORCE_TOL (to rounding) when every constraint holds
+# to the tolerance (issue 32). Not one of the batch's fields: simulate reports it as
+# "least_constraint_margin".
+S_MARGIN = 32
+N_SUMMARY = 33
 
 # Work array of the closed-form spans (one per run, see ``nonrocking_span``): the event
 # functions, then per response slot its state (0 not solved, 1 solved, 2 singular) and its two
@@ -103,6 +112,9 @@ ONE_SIDED_WIDE = 1e-6
 FORCE_TOL = 1e-10  # [-] tolerance on force margins, relative to the weight
 ACC_TOL = 1e-10  # [-] a new motion must accelerate by more than this times g
 REARM_TOL = 1e-9  # [-] a disarmed event is re-armed once its function exceeds this
+# [-] a force event re-selected is watched at least this far below its function's value
+# (above the rounding of event functions of order 1; see _events.shifted_level)
+LEVEL_GAP = 1e-15
 MAX_STEP_SAMPLES = 1.0  # [-] longest rocking step, in input samples (see docs/theory/solver)
 MIN_STEP = 1e-13  # [s] smallest rocking step before the run is declared failed
 MAX_EVENTS_PER_SAMPLE = 20000  # guards against chattering

@@ -46,13 +46,20 @@ from shipblock.equations import (
 from shipblock.solver._dopri import DP_A, DP_C, DP_E
 from shipblock.solver._events import (
     event_functions,
+    held_margin,
     impact_return_time,
     rearm,
     stuck_rocking_clear,
 )
 from shipblock.solver._fused import fma
 from shipblock.solver._history import store_sample
-from shipblock.solver._interpolate import bracketed_root, quintic_hermite, rotation_peak
+from shipblock.solver._interpolate import (
+    bracketed_root,
+    dip_possible,
+    quintic_hermite,
+    rotation_dip,
+    rotation_peak,
+)
 from shipblock.solver._layout import (
     EV_IMPACT,
     MS_ROCK,
@@ -63,6 +70,7 @@ from shipblock.solver._layout import (
     N_EVENTS,
     N_STATE,
     ROOT_TIME_TOL,
+    S_MARGIN,
     Y_OM,
     Y_TH,
     Y_VB,
@@ -72,7 +80,7 @@ from shipblock.solver._layout import (
     Y_XS,
 )
 from shipblock.solver._force_sampling import note_loads
-from shipblock.system import P_G, P_M, P_NM, P_R
+from shipblock.system import P_B, P_G, P_H, P_M, P_MUS1, P_MUS2, P_NM, P_R
 
 #: Largest |delta| [rad] for the series of :func:`small_angle_sincos` (truncation below 1e-17
 #: relative); beyond it the stage takes its own sine and cosine.
@@ -447,13 +455,45 @@ def locate_impact(p, gain, s, c, sn, th, om, w, al, pw, th1, om1, al1, a0, da, b
     return False, 0.0, 0.0, 0.0, 0.0, 0.0
 
 
+@njit(cache=True, forceinline=True)
+def note_margin(p, s, th1, fx1, fy1, Fx1, Fy1, g1, summary):
+    """Lower the run's least constraint margin (``S_MARGIN``) by an accepted step's end.
+
+    Only where an event function is not clear of zero: :func:`checked_step` has then put them
+    all in ``g1`` (the others are positive, and so is the margin).
+    """
+    if not stuck_rocking_clear(p, s, th1, fx1, fy1, Fx1, Fy1):
+        summary[S_MARGIN] = min(summary[S_MARGIN], held_margin(g1, np.int64(-1)))
+
+
+@njit(cache=True, forceinline=True)
+def held_at_impact(p, s, th_i, om_i, al_i, a_i, b_i):
+    r"""Whether the conditions mode 3 holds (both stick cones, both normal forces) hold at the
+    impact that ends a step, at the rotation ``th_i`` within ``ROOT_TIME_TOL`` of zero.
+
+    The end of the step, past the impact, tells nothing about them: there the mode's equations
+    have run on with the pivot on the wrong corner. A condition crossed before the impact and
+    met again by the step's end was missed until 2026-11-26 (found by the constraint audit of
+    the random campaign: stick violated by up to 1 % of the weight at the impact). Where one
+    fails the span refuses the step, and the kernel locates that event before the impact. The
+    geometry at ``th_i`` to first order (its square is below rounding):
+    :math:`\cos\varphi = (H + s\theta B)/R`, :math:`\sin\varphi = (B - s\theta H)/R`.
+    """
+    R = p[P_R]
+    c = (p[P_H] + s * th_i * p[P_B]) / R
+    sn = (p[P_B] - s * th_i * p[P_H]) / R
+    fx, fy, Fx, Fy = stuck_rocking_forces(p, c, sn, s, om_i, al_i, a_i, p[P_G] + b_i)
+    return (p[P_MUS1] * fy - abs(fx) >= 0.0 and p[P_MUS2] * Fy - abs(Fx) >= 0.0 and fy > 0.0
+            and Fy > 0.0)
+
+
 #: Verdicts of :func:`checked_step`.
 STEP_ACCEPTED, STEP_REFUSED, STEP_TO_IMPACT = 0, 1, 2
 
 
 @njit(cache=True, forceinline=True)
 def checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0, fh, h, dt,
-                 rtol, atol, armed, g1, need_g, whole):
+                 rtol, atol, levels, g1, need_g, whole):
     """One mode-3 step of the span to the next sample, and what the span makes of it.
 
     Returns the verdict, the step's end (state, rates, geometry, interface forces) and, for
@@ -486,36 +526,42 @@ def checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, f0
         # the usual case first: every event function clear of zero (read off the signs of
         # their numerators) and the rotation not dipping through zero inside the step
         clear = stuck_rocking_clear(p, s, th1, fx1, fy1, Fx1, Fy1)
-        quiet = clear and not (armed[EV_IMPACT] and s * th > 0.0 and s * om < 0.0
+        quiet = clear and not (levels[EV_IMPACT] == 0.0 and s * th > 0.0 and s * om < 0.0
                                and s * om1 > 0.0)
         if need_g or not clear:
             event_functions(p, ms, y, fx1, fy1, Fx1, Fy1, g1)
         if not clear:
-            quiet = not (armed[EV_IMPACT] and s * th > 0.0 and s * om < 0.0 and s * om1 > 0.0)
+            quiet = not (levels[EV_IMPACT] == 0.0 and s * th > 0.0 and s * om < 0.0
+                         and s * om1 > 0.0)
             for e in range(N_EVENTS):
-                if g1[e] < 0.0 and armed[e]:
+                if g1[e] < levels[e]:
                     quiet = False
+        if quiet and levels[EV_IMPACT] == 0.0 and dip_possible(s, th, al, th1, al1, h):
+            # both ends on the pivot's side, but the rotation may have crossed zero and come
+            # back inside the step: then the kernel takes it and locates the first crossing
+            quiet = rotation_dip(s, th, om, al, th1, om1, al1, h)[0] < 0.0
         if quiet:
             verdict = STEP_ACCEPTED
         else:
             y[Y_TH] = th
-            impact_alone = armed[EV_IMPACT] and g1[EV_IMPACT] < 0.0 and (
+            impact_alone = g1[EV_IMPACT] < levels[EV_IMPACT] and (
                 s * th > 0.0 or th == 0.0 and s * om > 0.0)
             for e in range(N_EVENTS):
-                if g1[e] < 0.0 and armed[e] and e != EV_IMPACT:
+                if g1[e] < levels[e] and e != EV_IMPACT:
                     impact_alone = False
             if impact_alone:
                 ok, t_imp, th_i, om_i, w_i, al_i = locate_impact(
                     p, gain, s, c, sn, th, om, w, al, pw, th1, om1, al1, a0, a1 - a0, b0, b1 - b0,
                     f0, h, dt)
-                if ok:
+                if ok and held_at_impact(p, s, th_i, om_i, al_i, a0 + (a1 - a0) * (f0 + t_imp / dt),
+                                         b0 + (b1 - b0) * (f0 + t_imp / dt)):
                     verdict = STEP_TO_IMPACT
     return (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i, w_i,
             al_i)
 
 
 @njit(cache=True, forceinline=False, error_model="numpy", _nrt=False)
-def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol, armed, g0, g1,
+def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol, levels, g0, g1,
                        peak_th, peak_th_time, store, hist, modes, mode, summary):
     """Advance mode 3 to the next sample and on by whole samples, up to the next event.
 
@@ -541,8 +587,9 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
         Time since sample ``k`` [s], 0 <= tau < dt.
     dt, ax, ay, has_ay, sh, sv, rtol, atol
         As in :func:`~shipblock.solver._kernel.run`.
-    armed : ndarray of bool
-        Events being watched; disarmed ones are re-armed once clear of zero.
+    levels : ndarray
+        The level below which each event function fires (see
+        :func:`~shipblock.solver._events.shifted_level`); restored to 0 once clear of zero.
     g0, g1 : ndarray, shape (N_EVENTS,)
         The event functions at the start (updated to those where the span stopped, unless at
         an impact) and work.
@@ -552,7 +599,7 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
         History output as in ``run``, and the mode number to write.
     summary : ndarray, shape (N_SUMMARY,)
         The run's summary: the contact loads at every accepted step's end raise its peaks
-        (:func:`~shipblock.solver._loads.note_loads`).
+        (:func:`~shipblock.solver._force_sampling.note_loads`).
 
     Returns
     -------
@@ -602,11 +649,12 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
                 fh = h / dt
             (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i,
              w_i, al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0,
-                                       b1, f0, fh, h, dt, rtol, atol, armed, g1, np.bool_(True),
+                                       b1, f0, fh, h, dt, rtol, atol, levels, g1, np.bool_(True),
                                        np.bool_(False))
             if verdict == STEP_ACCEPTED:
-                all_armed = rearm(armed, g1)
+                all_armed = rearm(levels, g1)
                 note_loads(p, 1, fx1, fy1, Fx1, Fy1, summary)
+                note_margin(p, s, th1, fx1, fy1, Fx1, Fy1, g1, summary)
                 t0 = k * dt + tau
                 peak_th, peak_th_time = rotation_peak(peak_th, peak_th_time, th, om, al, th1,
                                                       om1, al1, h, t0,
@@ -633,12 +681,13 @@ def stuck_rocking_span(p, ms, y, k, tau, dt, ax, ay, has_ay, sh, sv, rtol, atol,
         b1 = sv * ay[k + 1] if has_ay else 0.0
         (verdict, th1, om1, w1, al1, pw1, c1, sn1, fx1, fy1, Fx1, Fy1, t_imp, th_i, om_i, w_i,
          al_i) = checked_step(p, ms, y, gain, s, c, sn, th, om, w, al, pw, a0, a1, b0, b1, 0.0,
-                              1.0, dt, dt, rtol, atol, armed, g1, not all_armed, np.bool_(True))
+                              1.0, dt, dt, rtol, atol, levels, g1, not all_armed, np.bool_(True))
         if verdict != STEP_ACCEPTED:
             break
         note_loads(p, 1, fx1, fy1, Fx1, Fy1, summary)
+        note_margin(p, s, th1, fx1, fy1, Fx1, Fy1, g1, summary)
         if not all_armed:
-            all_armed = rearm(armed, g1)
+            all_armed = rearm(levels, g1)
         if om * om1 <= 0.0:
             # between turns of theta_dot, |theta| is monotone (theta cannot cross zero inside
             # an accepted step): the running peak can only grow at a turn, or where the span
