@@ -533,10 +533,18 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             if n_ev > max_events:
                 failure = EV_STALL
                 break
-        rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
-            dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
-        event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
-                     delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
+        if first < 0:
+            # no event: the state, time and regimes are those k7 and g1 were evaluated at, so
+            # reuse them (first same as last; bitwise the same values, one evaluation less)
+            for m in range(nx):
+                k1[m] = k7[m]
+            for q in range(ng):
+                g0[q] = g1[q]
+        else:
+            rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y,
+                ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
+            event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
+                         delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
         # step-size controller (elementary, order 5 solution with a 4th-order error estimate;
         # Hairer's stabilised controller was tried: fewer rejections, as many evaluations)
         h = h * min(5.0, max(0.2, 0.9 * max(err, 1e-10) ** -0.2))
