@@ -499,7 +499,9 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             for m in range(nx):
                 x1[m] = xe[m]
         # histories at the samples passed
+        sampled = False
         while n_hist < n_samples and n_hist * dt_rec <= t_new + 1e-12 * dt_rec:
+            sampled = True
             ts = n_hist * dt_rec
             dense(r, min(1.0, max(0.0, (ts - t) / h)), xe)
             kinematics(xe, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
@@ -514,9 +516,11 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
         t = t_new
         for m in range(nx):
             x[m] = x1[m]
-        kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
-        contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs,
-                       delta, delta_dot, vt, fe, fn, normal, tang)
+        if first >= 0 or sampled:
+            # else the work arrays still hold x's contact forces from event_values(t + h, x1)
+            kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
+            contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs,
+                           delta, delta_dot, vt, fe, fn, normal, tang)
         _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n)
         if first >= 0:
             kind, index = _transition(first, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg,
