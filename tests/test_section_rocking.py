@@ -13,7 +13,7 @@ at theta = 0 after and before an impact follows from the peak rotations either s
     e = omega+ / omega- = sqrt(f(theta_2) / f(theta_1)),  f(theta) = cos(alpha - theta) - cos(alpha).
 
 For the compliant model the peaks are measured from the static state at the samples (dt = 1 ms,
-peaks of a slow swing, error ~1e-7 relative); the compliance adds O(1/k) to this measure.
+peaks of a slow swing: below ~3e-7 rad, ~3e-6 in e); the compliance adds O(1/k) to this measure.
 The closed form is :func:`shipblock.system.system_restitution` (the plastic impact at the new
 pivot with the interfaces sticking): Housner's ``1 - 1.5 sin^2(alpha)`` as the ship's mass
 vanishes.
