@@ -25,10 +25,13 @@ N_BLOCKS = 4
 
 
 def pair(k, half_width=24 * 0.0254, half_height=24 * 0.0254, mu_ground=0.2, mu_ship=0.8,
-         damping=0.5, n_springs=5):
-    """The rigid system and its compliant counterpart with caps of stiffness k per block."""
-    top = Cap(stiffness=k, mu_s=mu_ship, mu_k=mu_ship, damping_ratio=damping)
-    bottom = Cap(stiffness=k, mu_s=mu_ground, mu_k=mu_ground, damping_ratio=damping)
+         damping=0.5, n_springs=5, proportional_limit=7.4e6):
+    """The rigid system and its compliant counterpart with caps of stiffness k per block
+    (crushing at ``proportional_limit`` [Pa])."""
+    top = Cap(stiffness=k, mu_s=mu_ship, mu_k=mu_ship, damping_ratio=damping,
+              proportional_limit=proportional_limit)
+    bottom = Cap(stiffness=k, mu_s=mu_ground, mu_k=mu_ground, damping_ratio=damping,
+                 proportional_limit=proportional_limit)
     blk = Block(half_width=half_width, half_height=half_height, top=top, bottom=bottom)
     ship = Ship(mass=SHIP_MASS, roll_inertia=SHIP_MASS * 4.0, g_height=3.0, keel_half_width=1.0,
                 half_beam=5.0)

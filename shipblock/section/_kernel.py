@@ -499,7 +499,9 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             for m in range(nx):
                 x1[m] = xe[m]
         # histories at the samples passed
+        sampled = False
         while n_hist < n_samples and n_hist * dt_rec <= t_new + 1e-12 * dt_rec:
+            sampled = True
             ts = n_hist * dt_rec
             dense(r, min(1.0, max(0.0, (ts - t) / h)), xe)
             kinematics(xe, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
@@ -514,9 +516,11 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
         t = t_new
         for m in range(nx):
             x[m] = x1[m]
-        kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
-        contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs,
-                       delta, delta_dot, vt, fe, fn, normal, tang)
+        if first >= 0 or sampled:
+            # else the work arrays still hold x's contact forces from event_values(t + h, x1)
+            kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
+            contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs,
+                           delta, delta_dot, vt, fe, fn, normal, tang)
         _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n)
         if first >= 0:
             kind, index = _transition(first, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg,
@@ -533,10 +537,18 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             if n_ev > max_events:
                 failure = EV_STALL
                 break
-        rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
-            dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
-        event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
-                     delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
+        if first < 0:
+            # no event: the state, time and regimes are those k7 and g1 were evaluated at, so
+            # reuse them (first same as last; bitwise the same values, one evaluation less)
+            for m in range(nx):
+                k1[m] = k7[m]
+            for q in range(ng):
+                g0[q] = g1[q]
+        else:
+            rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y,
+                ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
+            event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
+                         delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
         # step-size controller (elementary, order 5 solution with a 4th-order error estimate;
         # Hairer's stabilised controller was tried: fewer rejections, as many evaluations)
         h = h * min(5.0, max(0.2, 0.9 * max(err, 1e-10) ** -0.2))
