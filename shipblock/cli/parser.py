@@ -197,6 +197,10 @@ def build_parser():
     s.add_argument("--max-scale-factor", type=float, default=4.0, help="default 4")
     s.add_argument("--no-processing", action="store_true",
                    help="spectra of the records as read (default: the default processing chain)")
+    s.add_argument("--max-per-event", type=int, metavar="N",
+                   help="at most N records from one earthquake (FEMA P-695 takes 2); the "
+                        "earthquake from the catalogue's event_id, else the QuakeML event, the "
+                        "record's header or event_name (default: no limit)")
     s.set_defaults(func=cmd_select)
 
     s = sub.add_parser("export", help="a study's results as CSV tables (runs, fragility)",
