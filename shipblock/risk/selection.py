@@ -34,9 +34,8 @@ geometric mean), which is what the ship-block model sees.
 
 **Records per earthquake.** Several records of one earthquake share its source and path, so a
 suite drawn mostly from one event understates the record-to-record variability; common practice
-caps them (FEMA P-695 takes at most two records per event in its far-field set; ASCE 7-16
-§16.2.2 asks for records from events of magnitudes, distances and mechanisms consistent with
-the hazard, which in practice means spreading them over events). With ``max_per_event = N`` the
+caps them (FEMA P-695 takes at most two records from any one earthquake in its record sets).
+With ``max_per_event = N`` the
 suite is the k records of least total misfit with at most N from any one earthquake: taken best
 first, a record is skipped when its earthquake already has N. The records allowed by such caps
 form a matroid (a partition matroid), on which this greedy choice is optimal, so no other set
@@ -58,8 +57,8 @@ References
 .. [2] Baker, J. W. and Lee, C. (2018). An improved algorithm for selecting ground motions to
    match a conditional spectrum. *J. Earthquake Eng.* 22(4), 708-723 (selection by the sum of
    squared log residuals).
-.. [3] FEMA P-695 (2009). *Quantification of Building Seismic Performance Factors*, §A.8 (the
-   far-field record set: no more than two records from any one event); Edmonds, J. (1971).
+.. [3] FEMA P-695 (2009). *Quantification of Building Seismic Performance Factors*, Appendix A
+   (the record sets: no more than two records from any one earthquake); Edmonds, J. (1971).
    Matroids and the greedy algorithm. *Math. Programming* 1, 127-136.
 """
 
