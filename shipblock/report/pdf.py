@@ -50,6 +50,9 @@ _LEADING = 1.3  # line height / font size
 #: A heading needs this much space below it on its page, or it goes to the next [in].
 _KEEP_WITH_NEXT = 1.4
 
+#: A column is narrowed below its longest word only after every other column [characters].
+_LONG_WORD = 24
+
 #: A table shorter than this is kept on one page [in].
 _SHORT_TABLE = 3.0
 
@@ -142,12 +145,21 @@ def _paragraph(layout: _Layout, block: Paragraph) -> None:
 
 
 def _column_widths(rows, available: int) -> list[int]:
-    """Each column as wide as its longest cell, the widest narrowed until the row fits."""
-    widths = [max(max((len(line) for line in str(cell).splitlines()), default=0) for cell in col)
-              for col in zip(*rows, strict=True)]
-    widths = [max(w, 1) for w in widths]
-    while sum(widths) > available and max(widths) > 6:
-        widths[int(np.argmax(widths))] -= 1
+    """Each column as wide as its longest cell; while the row is too wide, the widest column
+    still wider than its longest word (at most :data:`_LONG_WORD` characters) is narrowed,
+    then, if that is not enough, the widest of all (its words broken)."""
+    columns = list(zip(*rows, strict=True))
+    widths = [max(1, max(len(line) for cell in col for line in str(cell).splitlines() or [""]))
+              for col in columns]
+    words = [min(_LONG_WORD, max((len(w) for cell in col for w in str(cell).split()), default=1))
+             for col in columns]
+    while sum(widths) > available:
+        wide = [j for j, (w, m) in enumerate(zip(widths, words, strict=True)) if w > m]
+        if not wide:
+            wide = [j for j, w in enumerate(widths) if w > 6]
+        if not wide:
+            break
+        widths[max(wide, key=lambda j: widths[j])] -= 1
     return widths
 
 
