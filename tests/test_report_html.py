@@ -17,7 +17,7 @@ import xarray as xr
 from shipblock.cli import main
 from shipblock.fragility.export import fragility_table
 from shipblock.fragility.pipeline import run_pipeline
-from shipblock.report_html import record_spectra, report_html, study_spectra
+from shipblock.report import record_spectra, report_html, study_spectra
 from shipblock.risk import run_risk
 from shipblock.scaling import read_target_spectrum
 

@@ -4,7 +4,9 @@ the spectrum being linear in the record) among records of other shapes."""
 
 from __future__ import annotations
 
+import itertools
 import math
+from collections import Counter
 
 import numpy as np
 import pytest
@@ -15,7 +17,12 @@ from shipblock.records.catalogue import load_catalogue
 from shipblock.cli import main
 from shipblock.errors import ParameterError
 from shipblock.fragility.pipeline import load_pipeline
-from shipblock.risk.selection import match_record, select_records, selection_toml
+from shipblock.risk.selection import (
+    event_identity,
+    match_record,
+    select_records,
+    selection_toml,
+)
 from shipblock.scaling import TargetSpectrum
 
 from .test_pipeline import PIPELINE
@@ -48,7 +55,9 @@ RECORDS = {
 }
 
 
-def write_catalogue(directory, records=RECORDS):
+def write_catalogue(directory, records=RECORDS, extra=None):
+    """A catalogue of the records (name -> horizontal, vertical) as miniSEED files; ``extra``:
+    name -> more lines of its table (its event)."""
     directory.mkdir(parents=True, exist_ok=True)
     lines = ["schema_version = 1"]
     for name, (h, v) in records.items():
@@ -62,7 +71,8 @@ def write_catalogue(directory, records=RECORDS):
         st.write(str(directory / f"{name}.mseed"), format="MSEED")
         lines += ["[[record]]", f'id = "syn/{name}"', f'files = ["{name}.mseed"]',
                   'units = "m/s^2"', f'station = "{name.upper()}"', 'network = "XX"',
-                  'license = "CC0"', 'credit = "synthetic"', "[record.components]",
+                  'license = "CC0"', 'credit = "synthetic"', *(extra or {}).get(name, []),
+                  "[record.components]",
                   'HNN = "H1"', 'HNZ = "V"']
     path = directory / "catalogue.toml"
     path.write_text("\n".join(lines) + "\n")
@@ -208,3 +218,104 @@ def test_azimuth_of_a_north_component_gives_its_spectrum_and_east_its_other():
             assert a.id == b.id
             np.testing.assert_allclose(a.sa_h, b.sa_h, rtol=1e-9)
         assert rotated.options["horizontal"] == f"azimuth {azimuth:g} deg"
+
+
+# ------------------------------------------------------------------------------ per earthquake
+#: Copies of the target's record scaled by c: unscaled, the misfit of each is |ln c| exactly.
+EVENT_RECORDS = {"r1": 1.0, "r2": 1.1, "r3": 1.2, "r4": 1.3, "r5": 1.5}
+
+
+@pytest.fixture(scope="module")
+def event_catalogue(tmp_path_factory):
+    """r1, r2, r3 of earthquake A (one QuakeML file), r4 of B and r5 of C (stated by
+    event_id)."""
+    from obspy.core.event import Catalog, Event, Origin, ResourceIdentifier
+
+    directory = tmp_path_factory.mktemp("events") / "lib"
+    directory.mkdir(parents=True)
+    event = Event(resource_id=ResourceIdentifier("smi:local/event/A"),
+                  origins=[Origin(time=UTCDateTime(2020, 1, 1, 0, 0, 5), latitude=38.2,
+                                  longitude=-122.3, depth=8000.0)])
+    Catalog([event]).write(str(directory / "eventA.xml"), format="QUAKEML")
+    extra = {"r1": ['event = "eventA.xml"'], "r2": ['event = "eventA.xml"'],
+             "r3": ['event = "eventA.xml"'], "r4": ['event_id = "B"'], "r5": ['event_id = "C"']}
+    records = {name: (c * H_A, c * V_A) for name, c in EVENT_RECORDS.items()}
+    return write_catalogue(directory, records, extra)
+
+
+def _total(ids):
+    return sum(abs(math.log(EVENT_RECORDS[i.split("/")[-1]])) for i in ids)
+
+
+def test_at_most_n_records_per_earthquake_changes_the_suite_to_the_best_within_the_caps(
+        event_catalogue):
+    chosen = {}
+    for cap in (None, 2, 1):
+        sel = select(event_catalogue, 3, scale=False, max_per_event=cap)
+        chosen[cap] = [m.id for m in sel.chosen]
+        # the misfits are the closed form |ln c|
+        for m in sel.chosen:
+            assert m.misfit == pytest.approx(abs(math.log(EVENT_RECORDS[m.id[4:]])), abs=1e-12)
+    assert chosen[None] == ["syn/r1", "syn/r2", "syn/r3"]  # all three of earthquake A
+    assert chosen[2] == ["syn/r1", "syn/r2", "syn/r4"]
+    assert chosen[1] == ["syn/r1", "syn/r4", "syn/r5"]
+    # optimal: no set of 3 within the caps has a smaller total misfit (all 10 sets tried)
+    events = {"r1": "A", "r2": "A", "r3": "A", "r4": "B", "r5": "C"}
+    for cap in (2, 1):
+        allowed = [c for c in itertools.combinations(EVENT_RECORDS, 3)
+                   if max(Counter(events[r] for r in c).values()) <= cap]
+        assert _total(chosen[cap]) == pytest.approx(min(_total(c) for c in allowed), rel=1e-12)
+    sel = select(event_catalogue, 3, scale=False, max_per_event=1)
+    assert sel.capped == {"syn/r2": "smi:local/event/A", "syn/r3": "smi:local/event/A"}
+    assert [m.event for m in sel.chosen] == ["smi:local/event/A", "B", "C"]
+    assert sel.options["max_per_event"] == 1
+
+
+def test_a_cap_the_catalogue_cannot_meet_and_an_unknown_earthquake_are_refused(
+        event_catalogue, catalogue):
+    with pytest.raises(ParameterError, match=r"max_per_event = 1: the 5 matched records come "
+                                             r"from 3 earthquake\(s\), so at most 3 can be "
+                                             r"chosen, not k = 4"):
+        select(event_catalogue, 4, scale=False, max_per_event=1)
+    with pytest.raises(ParameterError, match="max_per_event"):
+        select(event_catalogue, 2, max_per_event=0)
+    # the records of the first catalogue name no earthquake: refused only with a cap
+    assert len(select(catalogue, 2).chosen) == 2
+    with pytest.raises(ParameterError, match=r"max_per_event: the earthquake of record "
+                                             r"'syn/a1' is not known .* event_id"):
+        select(catalogue, 2, max_per_event=1)
+
+
+def test_event_identity_order(event_catalogue):
+    entries = load_catalogue(event_catalogue)
+    stated, quakeml = entries["syn/r4"], entries["syn/r1"]
+    # the catalogue's event_id wins over what the record says
+    assert event_identity(stated, {"event": {"id": "smi:x"}}) == ("B", "catalogue event_id")
+    assert event_identity(quakeml, {"event": {"id": "smi:x", "name": "n"}}) == (
+        "smi:x", "QuakeML event id")
+    origin = {"time": "2020-01-01T00:00:05.250000Z", "latitude": 38.2049, "longitude": -122.31}
+    assert event_identity(quakeml, {"event": origin}) == (
+        "2020-01-01T00:00:05 at 38.20, -122.31", "origin time and epicentre")
+    assert event_identity(quakeml, {"event": {"name": "Northridge-01"}}) == (
+        "Northridge-01", "event name in the record")
+    assert event_identity(quakeml, {"event": None}) == (
+        str(quakeml.event), "catalogue event file")
+    # the records as read: the QuakeML file's resource id
+    assert event_identity(quakeml, quakeml.read().metadata) == (
+        "smi:local/event/A", "QuakeML event id")
+
+
+def test_command_line_caps_records_per_earthquake(event_catalogue, tmp_path, capsys):
+    target = tmp_path / "target.csv"
+    target.write_text("period [s], Sa [m/s^2]\n" + "".join(
+        f"{float(p)!r}, {float(s)!r}\n" for p, s in zip(PERIODS, TARGET_H.sa, strict=True)))
+    out = tmp_path / "selected.toml"
+    assert main(["-q", "select", str(event_catalogue), "--target", str(target), "-k", "3",
+                 "--no-scale", "--no-processing", "--max-per-event", "1", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "at most 1 per earthquake: 3 earthquake(s)" in text
+    assert "left out for max_per_event: syn/r2 (smi:local/event/A)" in text
+    back = load_catalogue(out)
+    assert list(back) == ["syn/r1", "syn/r4", "syn/r5"]
+    assert [back[i].extra["selection_event"] for i in back] == ["smi:local/event/A", "B", "C"]
+    assert "# At most 1 record(s) per earthquake" in out.read_text()

@@ -197,6 +197,10 @@ def build_parser():
     s.add_argument("--max-scale-factor", type=float, default=4.0, help="default 4")
     s.add_argument("--no-processing", action="store_true",
                    help="spectra of the records as read (default: the default processing chain)")
+    s.add_argument("--max-per-event", type=int, metavar="N",
+                   help="at most N records from one earthquake (FEMA P-695 takes 2); the "
+                        "earthquake from the catalogue's event_id, else the QuakeML event, the "
+                        "record's header or event_name (default: no limit)")
     s.set_defaults(func=cmd_select)
 
     s = sub.add_parser("export", help="a study's results as CSV tables (runs, fragility)",
@@ -209,9 +213,10 @@ def build_parser():
     s.add_argument("--csv", required=True, metavar="DIR", help="folder for the CSV tables")
     s.set_defaults(func=cmd_export)
 
-    s = sub.add_parser("report", help="a study's report: one HTML file with its figures, and CSV "
-                                      "tables",
-                       description="Write a self-contained HTML report of a results file of "
+    s = sub.add_parser("report", help="a study's report: one HTML or PDF file with its figures, "
+                                      "and CSV tables",
+                       description="Write a self-contained HTML (or PDF) report of a results "
+                       "file of "
                        "'shipblock run': the study (pipeline, design, system with units, "
                        "processing, solver options), the records used and left out, their "
                        "spectra against a target spectrum, the limit states, the fragility "
@@ -228,8 +233,11 @@ def build_parser():
     s.add_argument("--units", help="unit of the target's Sa (default: from its header)")
     s.add_argument("--period-range", nargs=2, type=float, metavar=("TA", "TB"),
                    help="periods of the match with --target [s] (default: the target's)")
-    s.add_argument("--output", "-o", default="report.html", help="HTML file to write "
-                                                                  "(default report.html)")
+    s.add_argument("--format", choices=["html", "pdf"],
+                   help="html (one self-contained file) or pdf (A4 pages, the same content); "
+                        "default: from the suffix of --output, else html")
+    s.add_argument("--output", "-o", help="file to write (default report.html, or report.pdf "
+                                          "with --format pdf)")
     s.set_defaults(func=cmd_report)
 
     s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "

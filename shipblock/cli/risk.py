@@ -44,7 +44,7 @@ def cmd_select(args):
         vertical_weight=args.vertical_weight, scale=not args.no_scale,
         min_scale_factor=args.min_scale_factor, max_scale_factor=args.max_scale_factor,
         horizontal=args.horizontal, azimuth=args.azimuth,
-        processing=[] if args.no_processing else None)
+        processing=[] if args.no_processing else None, max_per_event=args.max_per_event)
     output = Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     partial = output.with_name(output.name + ".part")

@@ -1,6 +1,6 @@
 """The commands of a study: ``shipblock run`` (a pipeline), ``history`` (one of its runs again,
 in full), ``plot`` (a figure of a results file), ``export`` (its CSV tables) and ``report`` (its
-HTML report)."""
+HTML or PDF report)."""
 
 from __future__ import annotations
 
@@ -135,12 +135,13 @@ def cmd_export(args):
 
 
 def cmd_report(args):
-    from shipblock.report_html import write_report
+    from shipblock.report import write_report
     from shipblock.risk.selection import target_from_file
 
     target = None if args.target is None else target_from_file(args.target, args.units)
-    written = write_report(args.results, args.output, hazard_results=args.hazard_results,
-                           target=target, period_range=args.period_range)
+    output = args.output or f"report.{args.format or 'html'}"
+    written = write_report(args.results, output, hazard_results=args.hazard_results,
+                           target=target, period_range=args.period_range, format=args.format)
     sys.stdout.write(f"report written to {written[0]}\n")
     for path in written[1:]:
         sys.stdout.write(f"written {path}\n")

@@ -39,6 +39,11 @@ measure it is for and the file's provenance (path, SHA-256, layout, site):
     ``Sa(1.0) [m/s^2], poe_50yr [-]`` (probability of exceedance in 50 years); comma,
     semicolon or white space separated; ``#`` starts a comment.
 
+Not read: a CSV saved from the USGS Unified Hazard Tool. No real example or description of
+such a file was found (the tool's archived source has no CSV export of curves; the
+``nshmp-haz-ws`` web apps' CSV is another tool's and names no measure): read the JSON of its
+services (``usgs-json``) or a ``table`` instead.
+
 Rates must not increase with the level; levels must increase. A file with several sites needs
 ``site`` (a name, or ``(lon, lat)`` in degrees matched within 0.001 deg).
 

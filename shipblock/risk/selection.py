@@ -32,6 +32,20 @@ scaling is on, every factor is raised by the common ratio that lifts the lowest 
 check on maximum-direction spectra; here it is made on the component the study applies (or the
 geometric mean), which is what the ship-block model sees.
 
+**Records per earthquake.** Several records of one earthquake share its source and path, so a
+suite drawn mostly from one event understates the record-to-record variability; common practice
+caps them (FEMA P-695 takes at most two records from any one earthquake in its record sets).
+With ``max_per_event = N`` the
+suite is the k records of least total misfit with at most N from any one earthquake: taken best
+first, a record is skipped when its earthquake already has N. The records allowed by such caps
+form a matroid (a partition matroid), on which this greedy choice is optimal, so no other set
+of k records within the caps has a smaller total misfit [3]_. The earthquake of a record is
+(:func:`event_identity`, first found): the catalogue key ``event_id`` of its table; the
+QuakeML event's resource id (the table's ``event`` file); the origin time (to the second) and
+epicentre (to 0.01 deg) of an event given without id; the event name the record's own header
+gives (PEER NGA ``.AT2``); the table's ``event_name``; the ``event`` file itself. Two QuakeML
+files of one earthquake from different agencies have different ids: state ``event_id`` then.
+
 The suite is written as a catalogue (:func:`selection_toml`): the chosen records' tables with
 paths relative to the new file, each with ``selection_rank``, ``selection_scale_factor`` and
 ``selection_misfit``; a pipeline reads it with ``ids = "all"``.
@@ -43,12 +57,16 @@ References
 .. [2] Baker, J. W. and Lee, C. (2018). An improved algorithm for selecting ground motions to
    match a conditional spectrum. *J. Earthquake Eng.* 22(4), 708-723 (selection by the sum of
    squared log residuals).
+.. [3] FEMA P-695 (2009). *Quantification of Building Seismic Performance Factors*, Appendix A
+   (the record sets: no more than two records from any one earthquake); Edmonds, J. (1971).
+   Matroids and the greedy algorithm. *Math. Programming* 1, 127-136.
 """
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from collections import Counter
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -63,6 +81,7 @@ __all__ = [
     "ASCE_SUITE_FLOOR",
     "RecordMatch",
     "Selection",
+    "event_identity",
     "match_record",
     "select_records",
     "selection_lines",
@@ -98,6 +117,8 @@ class RecordMatch:
         target).
     bounded : bool
         Whether the factor sits on a bound (the unbounded optimum was outside).
+    event : str
+        The record's earthquake (:func:`event_identity`; empty when none is known).
     """
 
     id: str
@@ -108,6 +129,7 @@ class RecordMatch:
     sa_h: np.ndarray
     sa_v: np.ndarray | None
     bounded: bool = False
+    event: str = ""
 
 
 @dataclass
@@ -138,6 +160,9 @@ class Selection:
         ``suite_ratio_min >= 0.9`` (ASCE 7-16 §16.2.3).
     options : dict
         The selection's settings, for the written catalogue.
+    capped : dict
+        Record id -> its earthquake, for the records that ranked above the last one chosen
+        but were left out by ``max_per_event`` (empty without it).
     """
 
     chosen: list
@@ -153,6 +178,7 @@ class Selection:
     suite_factor: float
     passes: bool
     options: dict = field(default_factory=dict)
+    capped: dict = field(default_factory=dict)
 
 
 def target_from_file(path, units: str | None = None) -> TargetSpectrum:
@@ -201,6 +227,43 @@ def _horizontal(motion, horizontal: str | None, periods, damping):
     if horizontal not in comps:
         raise ShipblockError(f"has no {horizontal} component")
     return intensity.spectral_acceleration(comps[horizontal], motion.dt, periods, damping)
+
+
+def event_identity(entry: CatalogueEntry, metadata: dict | None = None) -> tuple[str, str] | None:
+    """The earthquake a catalogue record comes from, and how it is known.
+
+    Parameters
+    ----------
+    entry : CatalogueEntry
+        The record's catalogue table.
+    metadata : dict, optional
+        The metadata of the record as read (:attr:`GroundMotion.metadata
+        <shipblock.records.motion.GroundMotion.metadata>`): its ``event`` summary.
+
+    Returns
+    -------
+    (str, str) or None
+        The identity and where it comes from, first found of: the table's ``event_id``; the
+        QuakeML event's resource id; its origin time (to the second) and epicentre (to 0.01
+        deg); the event name in the record's header; the table's ``event_name``; the table's
+        ``event`` file. None when there is none of them.
+    """
+    if entry.extra.get("event_id") not in (None, ""):
+        return str(entry.extra["event_id"]), "catalogue event_id"
+    event = (metadata or {}).get("event") or {}
+    if event.get("id"):
+        return str(event["id"]), "QuakeML event id"
+    if event.get("time") and event.get("latitude") is not None \
+            and event.get("longitude") is not None:
+        return (f"{str(event['time'])[:19]} at {float(event['latitude']):.2f}, "
+                f"{float(event['longitude']):.2f}", "origin time and epicentre")
+    if event.get("name"):
+        return str(event["name"]), "event name in the record"
+    if entry.extra.get("event_name") not in (None, ""):
+        return str(entry.extra["event_name"]), "catalogue event_name"
+    if entry.event is not None:
+        return str(entry.event), "catalogue event file"
+    return None
 
 
 def match_record(record_id, sa_h, sa_v, target_h, target_v, *, vertical_weight=1.0,
@@ -259,7 +322,7 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
                    horizontal: str = "H1", azimuth: float | None = None,
                    damping: float = intensity.DEFAULT_DAMPING,
                    n_periods: int = DEFAULT_PERIODS, processing=None, ids=None,
-                   suite_floor: bool = True) -> Selection:
+                   suite_floor: bool = True, max_per_event: int | None = None) -> Selection:
     """Choose the ``k`` records of a catalogue that best match a target spectrum.
 
     Parameters
@@ -297,6 +360,9 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
         Only these catalogue records (default all).
     suite_floor : bool
         Raise the suite's factors to meet the 90 % floor when scaling.
+    max_per_event : int, optional
+        At most this many records from one earthquake (:func:`event_identity`); default no
+        limit.
 
     Returns
     -------
@@ -305,8 +371,10 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
     Raises
     ------
     ParameterError
-        Naming the argument: ``k`` larger than the records that could be matched, a bad range,
-        factor bounds or horizontal.
+        Naming the argument: ``k`` larger than the records that could be matched (or, with
+        ``max_per_event``, than the caps allow), a bad range, factor bounds or horizontal; with
+        ``max_per_event``, a record whose earthquake is not known (naming it and the catalogue
+        key ``event_id`` that states it).
     """
     entries = catalogue if isinstance(catalogue, dict) else load_catalogue(catalogue)
     k = checks.whole(k, "k", low=1, high=10_000)
@@ -317,6 +385,8 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
     min_scale_factor = checks.real(min_scale_factor, "min_scale_factor", low=0.0, low_open=True)
     max_scale_factor = checks.real(max_scale_factor, "max_scale_factor", low=min_scale_factor)
     n_periods = checks.whole(n_periods, "n_periods", low=2, high=1000)
+    if max_per_event is not None:
+        max_per_event = checks.whole(max_per_event, "max_per_event", low=1, high=10_000)
     if not isinstance(target, TargetSpectrum):
         target = target_from_file(target)
     if vertical_target is not None and not isinstance(vertical_target, TargetSpectrum):
@@ -344,7 +414,9 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
     for record_id in wanted:
         entry = entries[record_id]
         try:
-            motion = process_motion(entry.read(azimuth=azimuth), processing)
+            raw = entry.read(azimuth=azimuth)
+            event = event_identity(entry, raw.metadata)
+            motion = process_motion(raw, processing)
             sa_h = _horizontal(motion, None if azimuth is not None else horizontal, periods,
                                damping)
             sa_v = None
@@ -358,15 +430,21 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
         except (ShipblockError, ValueError, OSError) as exc:
             failures[record_id] = str(exc)
             continue
-        ranked.append(match_record(record_id, sa_h, sa_v, target_h, target_v,
-                                   vertical_weight=vertical_weight, scale=scale,
-                                   min_scale_factor=min_scale_factor,
-                                   max_scale_factor=max_scale_factor))
+        if max_per_event is not None and event is None:
+            raise ParameterError(f"max_per_event: the earthquake of record {record_id!r} is not "
+                                 "known (no QuakeML event, no event in its header, no "
+                                 "event_name); state it with event_id = \"...\" in its "
+                                 "catalogue table")
+        match = match_record(record_id, sa_h, sa_v, target_h, target_v,
+                             vertical_weight=vertical_weight, scale=scale,
+                             min_scale_factor=min_scale_factor,
+                             max_scale_factor=max_scale_factor)
+        ranked.append(replace(match, event="" if event is None else event[0]))
     if k > len(ranked):
         raise ParameterError(f"k = {k} but only {len(ranked)} records could be matched"
                              + (f" ({len(failures)} not: {failures})" if failures else ""))
     ranked.sort(key=lambda m: (m.misfit, m.id))
-    chosen = ranked[:k]
+    chosen, capped = _capped(ranked, k, max_per_event)
     factors = np.array([m.factor for m in chosen])
     mean_h = np.mean([m.factor * m.sa_h for m in chosen], axis=0)
     ratio = mean_h / target_h
@@ -389,10 +467,33 @@ def select_records(catalogue, target, k: int, *, period_range=None, vertical_tar
                "min_scale_factor": min_scale_factor, "max_scale_factor": max_scale_factor,
                "vertical_weight": vertical_weight if target_v is not None else 0.0,
                "target": target.source,
-               "vertical_target": None if vertical_target is None else vertical_target.source}
+               "vertical_target": None if vertical_target is None else vertical_target.source,
+               "max_per_event": max_per_event}
     return Selection(chosen, ranked, failures, periods, target_h, target_v, mean_h, mean_v,
                      float(ratio[i_min]), float(periods[i_min]), float(suite_factor),
-                     bool(ratio[i_min] >= ASCE_SUITE_FLOOR * (1 - 1e-12)), options)
+                     bool(ratio[i_min] >= ASCE_SUITE_FLOOR * (1 - 1e-12)), options, capped)
+
+
+def _capped(ranked, k, max_per_event):
+    """The ``k`` best of ``ranked`` (best first) with at most ``max_per_event`` per earthquake,
+    and the better-ranked records the cap left out (id -> earthquake)."""
+    if max_per_event is None:
+        return ranked[:k], {}
+    chosen, left_out, count = [], {}, Counter()
+    for m in ranked:
+        if count[m.event] >= max_per_event:
+            left_out[m.id] = m.event
+            continue
+        chosen.append(m)
+        count[m.event] += 1
+        if len(chosen) == k:
+            break
+    if len(chosen) < k:
+        events = len({m.event for m in ranked})
+        raise ParameterError(f"max_per_event = {max_per_event}: the {len(ranked)} matched records "
+                             f"come from {events} earthquake(s), so at most {len(chosen)} can be "
+                             f"chosen, not k = {k}")
+    return chosen, left_out
 
 
 def _rescaled(m: RecordMatch, c: float, target_h, target_v, w) -> RecordMatch:
@@ -400,7 +501,7 @@ def _rescaled(m: RecordMatch, c: float, target_h, target_v, w) -> RecordMatch:
     again = match_record(m.id, m.sa_h, m.sa_v, target_h / (m.factor * c), None if target_v is None
                          else target_v / (m.factor * c), vertical_weight=w, scale=False)
     return RecordMatch(m.id, m.factor * c, again.misfit, again.misfit_h, again.misfit_v,
-                       m.sa_h, m.sa_v, m.bounded)
+                       m.sa_h, m.sa_v, m.bounded, m.event)
 
 
 def _inline(value) -> str:
@@ -462,6 +563,8 @@ def selection_toml(selection: Selection, entries: dict, output) -> str:
         f"# Suite mean / target: lowest {selection.suite_ratio_min:.3f} at "
         f"{selection.suite_ratio_period:.3g} s: ASCE 7-16 §16.2.3 90 % check "
         f"{'passed' if selection.passes else 'FAILED'}.",
+        *([f"# At most {o['max_per_event']} record(s) per earthquake (selection_event; "
+           "shipblock.risk.selection.event_identity)."] if o.get("max_per_event") else []),
         "# selection_scale_factor is the factor that matches the target; a pipeline scales the "
         "records itself",
         "# to its IM levels (read this catalogue with ids = \"all\").",
@@ -472,6 +575,8 @@ def selection_toml(selection: Selection, entries: dict, output) -> str:
                  "selection_misfit": m.misfit, "selection_misfit_h": m.misfit_h}
         if np.isfinite(m.misfit_v):
             extra["selection_misfit_v"] = m.misfit_v
+        if m.event:
+            extra["selection_event"] = m.event
         lines += _entry_lines(entries[m.id], base, extra)
     return "\n".join(lines)
 
@@ -494,6 +599,12 @@ def selection_lines(selection: Selection) -> list[str]:
         if m.bounded:
             row += "  (factor at its bound)"
         lines.append(row)
+    if o.get("max_per_event"):
+        count = Counter(m.event for m in selection.chosen)
+        lines.append(f"at most {o['max_per_event']} per earthquake: {len(count)} earthquake(s), "
+                     + "; ".join(f"{n} from {event}" for event, n in count.items()))
+        for record_id, event in selection.capped.items():
+            lines.append(f"left out for max_per_event: {record_id} ({event})")
     if selection.suite_factor != 1.0:
         lines.append(f"suite factor {selection.suite_factor:.4g} applied to reach the 90 % floor")
     if not selection.passes and o["scale"]:

@@ -1,11 +1,14 @@
-"""A study's report: one self-contained HTML file, with its tables as CSV beside it.
+"""The content of a study's report, once, as blocks that :mod:`~shipblock.report.html` and
+:mod:`~shipblock.report.pdf` render.
 
-:func:`write_report` (``shipblock report results.nc -o report.html``) turns a result of
-:func:`~shipblock.fragility.pipeline.run_pipeline` (and, when there is one, the risk
-:func:`~shipblock.risk.study.run_risk` added to it) into a document a dock engineer can file:
+:func:`report_document` turns a result of :func:`~shipblock.fragility.pipeline.run_pipeline`
+(and, when there is one, the risk :func:`~shipblock.risk.study.run_risk` added to it) into a
+list of blocks (:class:`Heading`, :class:`Paragraph`, :class:`Table`, :class:`Preformatted`,
+:class:`Figure`, :class:`Links`), in the order a dock engineer reads them:
 
 1. the study: pipeline title and file, design, the system's parameters with their units, the
-   processing chain and the solver options, all read from the result's attributes;
+   processing chain and the solver options, all read from the result's attributes (the system
+   as stored, whatever the model: no system object is built);
 2. the records: id, station, channel, event, scale factors, whether each was used and, if not,
    why; with a target spectrum (the study's own match, or ``target=``), each record's spectrum
    against it;
@@ -13,33 +16,29 @@
 4. the fitted fragility curves with their bootstrap bands (the figures of
    :mod:`shipblock.plot`, titled with study, system and design) and the summary lines
    ``shipblock run`` prints (:func:`shipblock.fragility.report.study_report`);
-5. the risk over the docking period (:mod:`shipblock.plot_risk`) when the file holds it.
+5. the risk over the docking period (:mod:`shipblock.plot_risk`) when the file holds it;
+6. the CSV tables written beside the report.
 
-Figures are embedded as base64 PNG: the file opens anywhere, without network or the files it
-came from. Every value is the file's (SI inside, shown in the pipeline's unit for intensities),
-nothing is fitted again; the tables go to ``<report>_csv/`` through
-:func:`shipblock.fragility.export.write_csv`, the risk columns with them when there is a risk.
+Every value is the file's (SI inside, shown in the pipeline's unit for intensities), nothing is
+fitted again. Figures are blocks holding a function that draws them, so a renderer makes one
+figure at a time.
 """
 
 from __future__ import annotations
 
-import base64
-import html
-import io
 import json
 import textwrap
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 
-import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
 
 from shipblock import __version__
 from shipblock.errors import ParameterError
-from shipblock.fragility.export import write_csv
 from shipblock.fragility.report import display_units, im_label, study_report
 from shipblock.models import DEFAULT_MODEL, get_model, model_names
 from shipblock.plot import (
@@ -57,10 +56,70 @@ from shipblock.risk.study import risk_lines
 from shipblock.scaling import TargetSpectrum, spectrum_match
 from shipblock.units import STANDARD_GRAVITY
 
-__all__ = ["check_study", "record_spectra", "report_html", "study_spectra", "write_report"]
+__all__ = ["RISK", "Figure", "Heading", "Links", "Paragraph", "Preformatted", "Table",
+           "check_study", "record_spectra", "report_document", "study_spectra"]
 
-#: The risk variables ``shipblock risk`` adds to a result.
-_RISK = "risk_annual_rate"
+#: The variable ``shipblock risk`` adds to a result (the others go with it).
+RISK = "risk_annual_rate"
+
+
+# ------------------------------------------------------------------------------ blocks
+@dataclass(frozen=True)
+class Heading:
+    """A heading: level 1 the report's title, 2 a section, 3 a part of one."""
+
+    text: str
+    level: int = 2
+
+
+@dataclass(frozen=True)
+class Paragraph:
+    """Running text; with ``small`` the fine print under the title. Text between backquotes
+    is a command or a flag (``<code>`` in HTML); ``lines`` are kept apart (a line break)."""
+
+    lines: tuple[str, ...]
+    small: bool = False
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table of text cells; ``keys``: a two-column list of names and values, no header."""
+
+    header: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+    keys: bool = False
+
+
+@dataclass(frozen=True)
+class Preformatted:
+    """Text shown as is (monospaced), under a ``summary`` when it may be folded away."""
+
+    text: str
+    summary: str = ""
+
+
+@dataclass(frozen=True)
+class Figure:
+    """A figure: ``draw()`` makes it (a new matplotlib figure, closed by the renderer)."""
+
+    draw: Callable[[], object] = field(compare=False)
+    alt: str = ""
+
+
+@dataclass(frozen=True)
+class Links:
+    """Files written beside the report: name -> path relative to the report."""
+
+    items: tuple[tuple[str, str], ...]
+
+
+def _p(*lines, small=False) -> Paragraph:
+    return Paragraph(tuple(str(x) for x in lines), small)
+
+
+def _t(header, rows, keys=False) -> Table:
+    return Table(tuple(str(h) for h in header), tuple(tuple(str(c) for c in r) for r in rows),
+                 keys)
 
 
 def check_study(ds: xr.Dataset, name: str) -> None:
@@ -83,16 +142,6 @@ def check_study(ds: xr.Dataset, name: str) -> None:
 
 
 # ------------------------------------------------------------------------------ text helpers
-def _e(value) -> str:
-    return html.escape(str(value), quote=True)
-
-
-def _table(header, rows, cls="") -> str:
-    head = "".join(f"<th>{_e(h)}</th>" for h in header)
-    body = "".join("<tr>" + "".join(f"<td>{_e(c)}</td>" for c in row) + "</tr>" for row in rows)
-    return f'<table class="{cls}"><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>'
-
-
 def _number(value) -> str:
     if isinstance(value, bool) or value is None:
         return str(value).lower() if isinstance(value, bool) else "default"
@@ -105,18 +154,15 @@ def _number(value) -> str:
     return str(value)
 
 
-def _wrapped(lines) -> str:
-    """A figure title: ``lines`` wrapped to the study figures' width (:data:`TITLE_WIDTH`)."""
-    return "\n".join(w for line in lines for w in textwrap.wrap(line, TITLE_WIDTH))
+#: Width of the study figures [in], whose titles :data:`TITLE_WIDTH` characters fill.
+_STUDY_FIGURE_WIDTH = 9.0
 
 
-def _figure(fig, alt: str) -> str:
-    """A matplotlib figure as an embedded PNG (the figure is closed)."""
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=110)
-    plt.close(fig)
-    data = base64.b64encode(buffer.getvalue()).decode("ascii")
-    return f'<figure><img alt="{_e(alt)}" src="data:image/png;base64,{data}"></figure>'
+def _wrapped(lines, figure_width: float = _STUDY_FIGURE_WIDTH) -> str:
+    """A figure title: ``lines`` wrapped to the study figures' width (:data:`TITLE_WIDTH`
+    characters on a figure of theirs), shortened in proportion on a narrower figure."""
+    width = int(TITLE_WIDTH * min(1.0, figure_width / _STUDY_FIGURE_WIDTH))
+    return "\n".join(w for line in lines for w in textwrap.wrap(line, width))
 
 
 def _pipeline_document(ds) -> dict:
@@ -132,7 +178,7 @@ def _model(ds):
 
 
 # ------------------------------------------------------------------------------ sections
-def _study_section(ds, name) -> str:
+def _study_section(ds, name) -> list:
     unit, factor = display_units(ds)
     rows = [("title", ds.attrs.get("title", "")),
             ("pipeline file", ds.attrs.get("pipeline_source", "")),
@@ -140,7 +186,7 @@ def _study_section(ds, name) -> str:
             ("created", ds.attrs.get("created", "")),
             ("shipblock version", ds.attrs.get("shipblock_version", "")),
             ("pipeline fingerprint", ds.attrs.get("pipeline_fingerprint", ""))]
-    out = ["<h2>1. Study</h2>", _table(["", ""], rows, "keys")]
+    out = [Heading("1. Study"), _t(["", ""], rows, keys=True)]
     design = [("analysis", {"ida": "incremental dynamic analysis (IDA)",
                             "msa": "multiple stripe analysis (MSA)",
                             "cloud": "cloud (records at their own intensity)"}.get(
@@ -162,56 +208,57 @@ def _study_section(ds, name) -> str:
     fit = json.loads(ds.attrs.get("fit_options", "{}"))
     if fit:
         design.append(("fit options", ", ".join(f"{k} = {_number(v)}" for k, v in fit.items())))
-    out += ["<h3>Design</h3>", _table(["", ""], design, "keys")]
-    out.append(_system_table(ds))
+    out += [Heading("Design", 3), _t(["", ""], design, keys=True)]
+    out += _system_blocks(ds)
     chain = json.loads(ds.attrs.get("processing_chain", "[]"))
-    out.append("<h3>Processing chain</h3>")
-    out.append("<p>Applied to every record, in this order, before scaling.</p>" if chain else
-               "<p>None: the records as read.</p>")
+    out.append(Heading("Processing chain", 3))
+    out.append(_p("Applied to every record, in this order, before scaling." if chain else
+                  "None: the records as read."))
     if chain:
-        out.append(_table(["#", "step", "parameters"], [
+        out.append(_t(["#", "step", "parameters"], [
             (i + 1, step.get("step", ""), ", ".join(f"{k} = {_number(v)}" for k, v in
                                                     step.items() if k != "step"))
             for i, step in enumerate(chain)]))
-    out.append(_solver_table(ds))
-    out.append("<details><summary>The pipeline file as run</summary><pre>"
-               f"{_e(ds.attrs.get('pipeline', ''))}</pre></details>")
-    return "\n".join(out)
+    out += _solver_blocks(ds)
+    out.append(Preformatted(str(ds.attrs.get("pipeline", "")), "The pipeline file as run"))
+    return out
 
 
-def _system_table(ds) -> str:
+def _system_blocks(ds) -> list:
+    """The system as the result stores it (attribute ``system``), with the units and meaning
+    of each parameter from the model's description: no system object is built."""
     system = json.loads(ds.attrs["system"])
     model = _model(ds)
     fields = model.parameters if model is not None else {}
     rows = []
     for key, value in system.items():
-        field = fields.get(key)
-        units = field.units if field is not None else ""
+        spec = fields.get(key)
+        units = spec.units if spec is not None else ""
         rows.append((key, _number(value), "-" if units in ("", "1") else units,
-                     field.doc if field is not None else ""))
-    out = ["<h3>System</h3>",
-           f"<p>Model {_e(model.name if model else '?')}: "
-           f"{_e(model.description if model else 'not installed here')}. "
-           "None: the model's default (see the description).</p>",
-           _table(["parameter", "value", "unit", "what"], rows)]
+                     spec.doc if spec is not None else ""))
+    out = [Heading("System", 3),
+           _p(f"Model {model.name if model else '?'}: "
+              f"{model.description if model else 'not installed here'}. "
+              "None: the model's default (see the description)."),
+           _t(["parameter", "value", "unit", "what"], rows)]
     sweep = json.loads(ds.attrs.get("sweep", "{}"))
     if sweep:
-        out.append("<p>Swept (one fragility per combination):</p>")
-        out.append(_table(["parameter", "values"],
-                          [(k, ", ".join(_number(x) for x in v)) for k, v in sweep.items()]))
-    return "\n".join(out)
+        out.append(_p("Swept (one fragility per combination):"))
+        out.append(_t(["parameter", "values"],
+                      [(k, ", ".join(_number(x) for x in v)) for k, v in sweep.items()]))
+    return out
 
 
-def _solver_table(ds) -> str:
+def _solver_blocks(ds) -> list:
     options = json.loads(ds.attrs.get("solver_options", "{}"))
     model = _model(ds)
     fields = model.options if model is not None else {}
     rows = [(k, _number(v), "-" if (f := fields.get(k)) is None or f.units in ("", "1")
              else f.units, f.doc if f is not None else "") for k, v in options.items()]
-    return "<h3>Solver options</h3>" + _table(["option", "value", "unit", "what"], rows)
+    return [Heading("Solver options", 3), _t(["option", "value", "unit", "what"], rows)]
 
 
-def _records_table(ds, spectra) -> str:
+def _records_table(ds, spectra) -> Table:
     provenance = json.loads(ds.attrs.get("records_provenance", "{}"))
     unit, factor = display_units(ds)
     header = ["record", "station", "site", "horizontal", "event", "scale factors",
@@ -248,7 +295,7 @@ def _records_table(ds, spectra) -> str:
             row.insert(-1, f"{match['misfit']:.3g}" if isinstance(match, dict) else
                        f"not matched: {match}" if match else "-")
         rows.append(row)
-    return _table(header, rows)
+    return _t(header, rows)
 
 
 # ------------------------------------------------------------------------------ spectra
@@ -396,7 +443,7 @@ def _spectra_figure(ds, spectra):
 
 
 # ------------------------------------------------------------------------------ fragility, risk
-def _limit_states_section(ds) -> str:
+def _limit_states_section(ds) -> list:
     definitions = {d["name"]: d for d in json.loads(ds.attrs.get("limit_states", "[]"))}
     rows = []
     for name in (str(n) for n in ds["limit_state"].values):
@@ -404,13 +451,13 @@ def _limit_states_section(ds) -> str:
         edp = d.get("edp", "")
         long_name = ds[edp].attrs.get("long_name", "") if edp in ds else ""
         rows.append((name, limit_state_text(ds, name), long_name, d.get("description", "")))
-    return ("<h2>3. Limit states</h2><p>A run exceeds a limit state when its demand meets the "
-            "condition; a run that failed (separation, overturning) exceeds every response limit "
-            "state.</p>" + _table(["limit state", "definition", "demand parameter",
-                                    "description"], rows))
+    return [Heading("3. Limit states"),
+            _p("A run exceeds a limit state when its demand meets the condition; a run that "
+               "failed (separation, overturning) exceeds every response limit state."),
+            _t(["limit state", "definition", "demand parameter", "description"], rows)]
 
 
-def _fit_table(ds) -> str:
+def _fit_table(ds) -> Table:
     unit, factor = display_units(ds)
     sweep = [d for d in ds["median"].dims if d != "limit_state"]
     conf = ds["median_lower"].attrs.get("confidence") if "median_lower" in ds else None
@@ -434,7 +481,7 @@ def _fit_table(ds) -> str:
                      f"{int(at('n_fit_records'))}" if np.isfinite(at("n_fit_records")) else "-",
                      str(at("fit_method")) if "fit_method" in ds else "",
                      str(at("fit_error")) if "fit_error" in ds else ""])
-    return _table(header, rows)
+    return _t(header, rows)
 
 
 def _arrangements(ds) -> list[dict]:
@@ -447,30 +494,39 @@ def _arrangements(ds) -> list[dict]:
     return combos
 
 
-def _fragility_section(ds) -> str:
-    out = ["<h2>4. Fragility</h2>",
-           "<p>Lognormal fragility curves, median and dispersion beta, with the bootstrap band "
-           "over the records (the values of the results file).</p>", _fit_table(ds)]
+def _fragility_section(ds) -> list:
+    out = [Heading("4. Fragility"),
+           _p("Lognormal fragility curves, median and dispersion beta, with the bootstrap band "
+              "over the records (the values of the results file)."), _fit_table(ds)]
     lines = study_report(ds)
     if lines:
-        out.append("<p>What <code>shipblock run</code> said:</p><pre>"
-                   + _e("\n".join(lines)) + "</pre>")
+        out += [_p("What `shipblock run` said:"), Preformatted("\n".join(lines))]
     sweep = sweep_selection(ds)
     for combo in _arrangements(ds):
-        out.append(_figure(plot_fragility(ds, sweep=combo).figure,
-                           "fragility curves" + (f" at {sweep_text(combo)}" if combo else "")))
+        out.append(Figure(lambda combo=combo: plot_fragility(ds, sweep=combo).figure,
+                          "fragility curves" + (f" at {sweep_text(combo)}" if combo else "")))
     for dim in sweep:
-        out.append(_figure(plot_median_sweep(ds, dim, sweep=sweep).figure,
-                           f"median against {dim}"))
+        out.append(Figure(lambda dim=dim: plot_median_sweep(ds, dim, sweep=sweep).figure,
+                          f"median against {dim}"))
     if "im_level" in ds.coords and "peak_ship_slip" in ds:
-        out.append(_figure(plot_ida(ds, sweep=sweep).figure, "IDA curves"))
-    return "\n".join(out)
+        out.append(Figure(lambda: plot_ida(ds, sweep=sweep).figure, "IDA curves"))
+    return out
 
 
-def _risk_section(ds) -> str:
+def _risk_figure(ds, selection, days):
+    fig = plot_risk(ds, sweep=selection)[0].figure
+    # the figure's title with the study, system and design, as the study figures have
+    fig.suptitle(_wrapped([*study_caption(ds, selection),
+                           f"risk over a docking period of {days:g} days"
+                           + (f", drawn at {sweep_text(selection)}" if selection else "")],
+                          fig.get_figwidth()), fontsize=8.5, x=0.01, ha="left")
+    return fig
+
+
+def _risk_section(ds) -> list:
     days = float(ds.attrs["docking_days"])
-    sweep = [d for d in ds[_RISK].dims if d != "limit_state"]
-    banded = f"{_RISK}_lower" in ds
+    sweep = [d for d in ds[RISK].dims if d != "limit_state"]
+    banded = f"{RISK}_lower" in ds
 
     def value(name, index):
         v = float(ds[name].values[index])
@@ -481,55 +537,38 @@ def _risk_section(ds) -> str:
         return f"{v:.3g}" if np.isfinite(v) else "not fitted"
 
     rows = []
-    for index in np.ndindex(ds[_RISK].shape):
-        rate = float(ds[_RISK].values[index])
+    for index in np.ndindex(ds[RISK].shape):
+        rate = float(ds[RISK].values[index])
         rows.append([str(ds["limit_state"].values[index[0]]),
                      *(_number(ds[d].values[i]) for d, i in zip(sweep, index[1:], strict=True)),
-                     value(_RISK, index), f"{1 / rate:.4g}" if rate > 0 else "-",
+                     value(RISK, index), f"{1 / rate:.4g}" if rate > 0 else "-",
                      value("risk_probability", index),
                      f"{float(ds['risk_tail_fraction'].values[index]):.1%}"
                      if "risk_tail_fraction" in ds and rate > 0 else "-"])
     header = ["limit state", *sweep, "annual rate [1/yr]", "return period [yr]",
               f"P({days:g} d) [-]", "from beyond the curve"]
-    out = ["<h2>5. Risk over the docking period</h2>",
-           f"<p>Each fitted fragility convolved with the site hazard curve; probability of at "
-           f"least one exceedance during {days:g} days in the dock (Poisson). "
-           + (f"In brackets: {float(ds[f'{_RISK}_lower'].attrs['confidence']):.0%} bootstrap "
-              "band." if banded else
-              f"No bootstrap band ({_e(ds.attrs.get('risk_band', ''))}).") + "</p>",
-           "<pre>" + _e(risk_lines(ds)[0]) + "</pre>", _table(header, rows)]
+    out = [Heading("5. Risk over the docking period"),
+           _p(f"Each fitted fragility convolved with the site hazard curve; probability of at "
+              f"least one exceedance during {days:g} days in the dock (Poisson). "
+              + (f"In brackets: {float(ds[f'{RISK}_lower'].attrs['confidence']):.0%} bootstrap "
+                 "band." if banded else
+                 f"No bootstrap band ({ds.attrs.get('risk_band', '')}).")),
+           Preformatted(risk_lines(ds)[0]), _t(header, rows)]
     for selection in _arrangements(ds):
         where = f" at {sweep_text(selection)}" if selection else ""
-        if not np.isfinite(ds[_RISK].sel(selection).values).any():
-            out.append(f"<p>No figure{_e(where)}: no limit state was fitted there.</p>")
+        if not np.isfinite(ds[RISK].sel(selection).values).any():
+            out.append(_p(f"No figure{where}: no limit state was fitted there."))
             continue
-        fig = plot_risk(ds, sweep=selection)[0].figure
-        # the figure's title with the study, system and design, as the study figures have
-        fig.suptitle(_wrapped([*study_caption(ds, selection),
-                               f"risk over a docking period of {days:g} days"
-                               + (f", drawn at {sweep_text(selection)}" if selection else "")]),
-                     fontsize=8.5, x=0.01, ha="left")
-        out.append(_figure(fig, "hazard, fragilities and deaggregation" + where))
-    return "\n".join(out)
+        out.append(Figure(lambda selection=selection: _risk_figure(ds, selection, days),
+                          "hazard, fragilities and deaggregation" + where))
+    return out
 
 
 # ------------------------------------------------------------------------------ the document
-_STYLE = """
-body { font-family: sans-serif; max-width: 1100px; margin: 2em auto; color: #222; }
-h1 { font-size: 1.5em; } h2 { border-bottom: 1px solid #999; margin-top: 2em; }
-table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.9em; }
-th, td { border: 1px solid #bbb; padding: 3px 7px; text-align: left; vertical-align: top; }
-th { background: #eee; } table.keys thead { display: none; }
-table.keys td:first-child { font-weight: bold; white-space: nowrap; }
-figure { margin: 1em 0; } img { max-width: 100%; border: 1px solid #ddd; }
-pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; font-size: 0.85em; }
-.small { font-size: 0.85em; color: #555; }
-"""
-
-
-def report_html(ds: xr.Dataset, *, name: str = "results", spectra: Mapping | None = None,
-                tables: Mapping[str, str] | None = None) -> str:
-    """The report of a study result as one HTML document.
+def report_document(ds: xr.Dataset, *, name: str = "results", spectra: Mapping | None = None,
+                    tables: Mapping[str, str] | None = None) -> list:
+    """The report of a study result as blocks, for :func:`shipblock.report.html.report_html` and
+    :func:`shipblock.report.pdf.write_pdf`.
 
     Parameters
     ----------
@@ -541,107 +580,33 @@ def report_html(ds: xr.Dataset, *, name: str = "results", spectra: Mapping | Non
     spectra : mapping, optional
         Records' spectra against a target (:func:`record_spectra`, or the study's own match).
     tables : mapping of str to str, optional
-        CSV table name -> link written beside the report.
+        CSV table name -> its path relative to the report.
 
     Returns
     -------
-    str
+    list
+        :class:`Heading`, :class:`Paragraph`, :class:`Table`, :class:`Preformatted`,
+        :class:`Figure` and :class:`Links` blocks, in reading order; the first is the title.
     """
     check_study(ds, name)
     title = str(ds.attrs.get("title", "shipblock study"))
-    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
-             f"<title>{_e(title)}</title><style>{_STYLE}</style></head><body>",
-             f"<h1>{_e(title)}</h1>",
-             "<p class='small'>" + "<br>".join(_e(line) for line in study_caption(ds)) + "</p>",
-             f"<p class='small'>Report of {_e(name)} by shipblock {_e(__version__)}.</p>",
-             _study_section(ds, name), "<h2>2. Records</h2>",
-             f"<p>{_e(ds.attrs.get('records_used', ''))}</p>", _records_table(ds, spectra)]
+    blocks = [Heading(title, 1), _p(*study_caption(ds), small=True),
+              _p(f"Report of {name} by shipblock {__version__}.", small=True),
+              *_study_section(ds, name), Heading("2. Records"),
+              _p(ds.attrs.get("records_used", "")), _records_table(ds, spectra)]
     if spectra:
-        parts.append(_figure(_spectra_figure(ds, spectra), "spectra against the target"))
+        blocks.append(Figure(lambda: _spectra_figure(ds, spectra), "spectra against the target"))
     else:
-        parts.append("<p>No target spectrum: the study matched none and none was given "
-                     "(<code>--target</code>).</p>")
-    parts += [_limit_states_section(ds), _fragility_section(ds)]
-    if _RISK in ds:
-        parts.append(_risk_section(ds))
+        blocks.append(_p("No target spectrum: the study matched none and none was given "
+                         "(`--target`)."))
+    blocks += [*_limit_states_section(ds), *_fragility_section(ds)]
+    if RISK in ds:
+        blocks += _risk_section(ds)
     else:
-        parts.append("<h2>5. Risk over the docking period</h2><p>Not computed: make it with "
-                     "<code>shipblock risk</code> and pass the file with "
-                     "<code>--hazard-results</code>.</p>")
+        blocks += [Heading("5. Risk over the docking period"),
+                   _p("Not computed: make it with `shipblock risk` and pass the file with "
+                      "`--hazard-results`.")]
     if tables:
-        parts.append("<h2>6. Tables</h2><p>The results as CSV, every column with its unit:</p>"
-                     "<ul>" + "".join(f"<li><a href='{_e(link)}'>{_e(t)}</a></li>"
-                                      for t, link in tables.items()) + "</ul>")
-    parts.append("</body></html>")
-    return "\n".join(parts)
-
-
-def _open(path) -> xr.Dataset:
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such results file")
-    try:
-        with xr.open_dataset(path) as ds:
-            return ds.load()
-    except ValueError as exc:
-        raise ParameterError(f"{path}: not a NetCDF results file ({exc})") from None
-
-
-def write_report(results, output, *, hazard_results=None, target: TargetSpectrum | None = None,
-                 period_range=None) -> list[Path]:
-    """Write the HTML report of a study and its CSV tables.
-
-    Parameters
-    ----------
-    results : str or os.PathLike
-        NetCDF of ``shipblock run`` (or of ``shipblock risk``, which holds the study too).
-    output : str or os.PathLike
-        The HTML file; the tables go to the folder ``<output stem>_csv`` beside it.
-    hazard_results : str or os.PathLike, optional
-        NetCDF of ``shipblock risk`` for this study (the same pipeline fingerprint): its risk
-        goes into the report and the tables.
-    target : TargetSpectrum, optional
-        Target spectrum to draw the records' spectra against (:func:`record_spectra`); default
-        the study's own, if it matched one.
-    period_range : (float, float), optional
-        Periods of the match with ``target`` [s].
-
-    Returns
-    -------
-    list of Path
-        The HTML file, then the CSV tables.
-
-    Raises
-    ------
-    ParameterError
-        If a file is not a study result (named), or the risk file belongs to another study.
-    """
-    matplotlib.use("Agg")  # figures to PNG only; no display needed
-    ds = _open(results)
-    check_study(ds, str(results))
-    if hazard_results is not None:
-        risk = _open(hazard_results)
-        check_study(risk, str(hazard_results))
-        if _RISK not in risk:
-            raise ParameterError(f"{hazard_results}: holds no risk ({_RISK}); make it with "
-                                 "'shipblock risk'")
-        mine, theirs = (d.attrs.get("pipeline_fingerprint") for d in (ds, risk))
-        if mine != theirs:
-            raise ParameterError(f"{hazard_results}: the risk of another study (pipeline "
-                                 f"fingerprint {str(theirs)[:12]}..., {results} has "
-                                 f"{str(mine)[:12]}...)")
-        ds = risk
-    spectra = None
-    if target is not None:
-        spectra = record_spectra(ds, target, period_range)
-    elif "record_sa" in ds:
-        spectra = study_spectra(ds)
-    output = Path(output)
-    output.parent.mkdir(parents=True, exist_ok=True)
-    csv = write_csv(ds, output.with_name(output.stem + "_csv"))
-    links = {p.name: f"{p.parent.name}/{p.name}" for p in csv}
-    text = report_html(ds, name=str(results), spectra=spectra, tables=links)
-    partial = output.with_name(output.name + ".part")
-    partial.write_text(text, encoding="utf-8")
-    partial.replace(output)
-    return [output, *csv]
+        blocks += [Heading("6. Tables"), _p("The results as CSV, every column with its unit:"),
+                   Links(tuple(tables.items()))]
+    return blocks
