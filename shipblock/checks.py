@@ -74,6 +74,7 @@ __all__ = [
     "text",
     "time_step",
     "toml_document",
+    "toml_file",
     "unit",
     "whole",
 ]
@@ -653,3 +654,40 @@ def toml_document(source: str) -> dict:
                          else f"{where}.{key}" if where else str(key))
                 stack.append((child, level + 1, inner))
     return document
+
+
+def toml_file(path, what: str = "TOML file") -> dict:
+    """Read a TOML file with :func:`toml_document`; every failure a ParameterError naming it.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    what : str
+        What the file is, for the messages (``"system file"``).
+
+    Returns
+    -------
+    dict
+        The document.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``path`` is not a path.
+    ParameterError
+        Beginning with the file's path: unreadable (missing, a folder), not UTF-8, not TOML,
+        or nested deeper than :data:`MAX_TOML_DEPTH` levels.
+    """
+    path = pathname(path, "path", f"a {what}")
+    try:
+        with open(path, "rb") as fh:
+            return toml_document(fh.read().decode("utf-8"))
+    except OSError as exc:
+        raise ParameterError(f"{path}: cannot read the {what} ({exc})") from None
+    except UnicodeDecodeError:
+        raise ParameterError(f"{path}: not a text (UTF-8) TOML file") from None
+    except TomlNestingError as exc:
+        raise ParameterError(f"{path}: {exc.problem}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"{path}: not valid TOML: {exc}") from None

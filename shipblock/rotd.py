@@ -32,8 +32,13 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from shipblock import intensity
 from shipblock.errors import ParameterError
+from shipblock.intensity._checks import _as_record, _check_damping, _check_dt, _check_periods
+from shipblock.intensity.spectrum import (
+    DEFAULT_DAMPING,
+    SAMPLES_PER_PERIOD,
+    _nigam_jennings_coefficients,
+)
 
 __all__ = ["ANGLES_DEG", "RotDSpectrum", "rotd_spectrum"]
 
@@ -101,8 +106,8 @@ def _rotated_peaks(acc1, acc2, sub, cos, sin, a, b, c, d, ap, bp, cp, dp):  # pr
     return out
 
 
-def rotd_spectrum(acc1, acc2, dt, periods, damping=intensity.DEFAULT_DAMPING,
-                  samples_per_period=intensity.SAMPLES_PER_PERIOD) -> RotDSpectrum:
+def rotd_spectrum(acc1, acc2, dt, periods, damping=DEFAULT_DAMPING,
+                  samples_per_period=SAMPLES_PER_PERIOD) -> RotDSpectrum:
     """RotD50 and RotD100 pseudo-spectral accelerations of two orthogonal horizontals.
 
     Parameters
@@ -130,20 +135,20 @@ def rotd_spectrum(acc1, acc2, dt, periods, damping=intensity.DEFAULT_DAMPING,
         For records of different lengths, a period of zero or less, or arguments the single
         spectrum refuses (the message names the argument).
     """
-    a1 = intensity._as_record(acc1, "acc1")
-    a2 = intensity._as_record(acc2, "acc2")
+    a1 = _as_record(acc1, "acc1")
+    a2 = _as_record(acc2, "acc2")
     if a1.size != a2.size:
         raise ParameterError(f"acc1 and acc2 must have the same length, got {a1.size} and "
                              f"{a2.size}: the two horizontals of one record")
-    dt = intensity._check_dt(dt)
-    zeta = intensity._check_damping(damping)
-    periods = intensity._check_periods(periods)
+    dt = _check_dt(dt)
+    zeta = _check_damping(damping)
+    periods = _check_periods(periods)
     if np.any(periods <= 0):
         raise ParameterError("periods must be above zero for RotD spectra (T = 0 is the PGA "
                              "of the rotated record)")
     omega = 2.0 * np.pi / periods
     sub = np.maximum(1, np.ceil(samples_per_period * dt / periods)).astype(np.int64)
-    coef = intensity._nigam_jennings_coefficients(omega, zeta, dt / sub)
+    coef = _nigam_jennings_coefficients(omega, zeta, dt / sub)
     theta = np.radians(ANGLES_DEG)
     peaks = _rotated_peaks(a1, a2, sub, np.cos(theta), np.sin(theta),
                            *(np.ascontiguousarray(x) for x in coef))

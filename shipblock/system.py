@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import logging
 import math
-import tomllib
 from dataclasses import asdict, dataclass
 from functools import cached_property
 
 import numpy as np
 
-from shipblock.checks import choice, pathname, real, toml_document, whole
-from shipblock.errors import ParameterError, ParameterTypeError, TomlNestingError
+from shipblock.checks import choice, pathname, real, toml_file, whole
+from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.quantities import to_si
 from shipblock.units import STANDARD_GRAVITY
 
@@ -356,18 +355,7 @@ class ShipBlockSystem:
             :data:`shipblock.checks.MAX_TOML_DEPTH` levels, or an invalid system.
         """
         path = pathname(path, "path", "a system TOML file")
-        try:
-            with open(path, "rb") as fh:
-                data = toml_document(fh.read().decode("utf-8"))
-        except OSError as exc:
-            raise ParameterError(f"{path}: cannot read the system file ({exc})") from None
-        except UnicodeDecodeError:
-            raise ParameterError(f"{path}: not a text (UTF-8) TOML file") from None
-        except TomlNestingError as exc:
-            raise ParameterError(f"{path}: {exc.problem}") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise ParameterError(f"{path}: not valid TOML: {exc}") from None
-        return cls.from_mapping(data, source=str(path))
+        return cls.from_mapping(toml_file(path, "system file"), source=str(path))
 
     def replace(self, **changes) -> ShipBlockSystem:
         """A copy with some parameters changed (validated again)."""

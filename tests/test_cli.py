@@ -272,3 +272,26 @@ def test_compile_notice_speaks_once_and_only_when_numba_compiles():
     with compile_notice(said.append):
         assert thrice(2.0) == 6.0  # already compiled
     assert len(said) == 1
+
+
+def test_processing_chain_file_is_read_through_the_checked_toml_reader(tmp_path, capsys):
+    """--processing FILE: a chain file is applied; a file that is not TOML, or nests deeper than
+    shipblock reads, is refused in one line naming the file (shipblock.checks.toml_file)."""
+    from shipblock.checks import MAX_TOML_DEPTH
+
+    good = tmp_path / "chain.toml"
+    good.write_text('[[processing]]\nstep = "demean"\n', encoding="utf-8")
+    code, demeaned, _ = run(capsys, "info", "--record", "NP.1759", "--processing", "demean")
+    assert code == 0
+    code, out, _ = run(capsys, "info", "--record", "NP.1759", "--processing", str(good))
+    assert code == 0 and out == demeaned
+    broken = tmp_path / "broken.toml"
+    broken.write_text('[[processing]]\nstep = "demean\n', encoding="utf-8")
+    code, _, err = run(capsys, "info", "--record", "NP.1759", "--processing", str(broken))
+    assert code != 0
+    assert str(broken) in err and "not valid TOML" in err and "Traceback" not in err
+    deep = tmp_path / "deep.toml"
+    deep.write_text("x = " + "[" * (MAX_TOML_DEPTH + 5) + "]" * (MAX_TOML_DEPTH + 5) + "\n",
+                    encoding="utf-8")
+    code, _, err = run(capsys, "info", "--record", "NP.1759", "--processing", str(deep))
+    assert code != 0 and str(deep) in err and "nested deeper" in err

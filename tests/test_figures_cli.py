@@ -136,3 +136,11 @@ def test_a_batch_history_file_is_titled_with_its_record_level_and_run():
         "10:20:44 UTC Mw 6.02, scaled to PGA 0.8 g, scale factor 1.95; run 37 of "
         "pipelines/demo.toml")
     assert dataset_record_line(xr.Dataset()) == ""
+
+
+def test_record_text_names_a_motion_from_arrays_by_its_label():
+    """The figure title's record line uses GroundMotion.name, which is the label of a motion
+    built from arrays (no workaround in the plot code), even when it looks like a path."""
+    motion = GroundMotion.from_arrays(np.sin(np.linspace(0.0, 20.0, 400)), dt=0.01,
+                                      name="runs/case 3")
+    assert record_text(motion) == "record runs/case 3"

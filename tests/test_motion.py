@@ -313,3 +313,18 @@ def test_truncated_mseed_is_refused(tmp_path):
 def test_missing_inventory_file():
     with pytest.raises(RecordError, match="nothere.xml"):
         read_motion(NAPA / "NP.1765.mseed", inventory=os.fspath(NAPA / "nothere.xml"))
+
+
+def test_name_of_a_motion_from_arrays_is_the_name_given_never_a_dict_repr():
+    """from_arrays keeps its label as given (it is not a file: no basename is taken), after
+    processing too, and a motion whose metadata lost its file list still has a readable name."""
+    acc = np.sin(np.linspace(0.0, 20.0, 400))
+    assert GroundMotion.from_arrays(acc, dt=0.01).name == "synthetic"
+    labelled = GroundMotion.from_arrays(acc, dt=0.01, name="runs/case 3")
+    assert labelled.name == "runs/case 3"
+    assert labelled.with_stream(labelled.stream.copy(), "demean").name == "runs/case 3"
+    bare = dict(labelled.metadata, source_files=[])
+    assert GroundMotion(labelled.stream, bare).name == "runs/case 3"
+    nameless = dict(labelled.metadata, station={"location": "00"}, source_files=[])
+    name = GroundMotion(labelled.stream, nameless).name
+    assert name == "record" and "{" not in name

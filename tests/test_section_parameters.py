@@ -6,6 +6,7 @@ import pytest
 
 from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.section import NAVY_BLOCK, Block, BlockLine, Cap, DockSection, Ship, Wind
+from shipblock.section import parameters as P
 from shipblock.section.model import assemble, lobatto
 from shipblock.units import INCH
 
@@ -32,6 +33,37 @@ def test_navy_block_defaults_and_derived_stiffness():
     # concrete core and two oak caps
     expected = area * ((48 - 12) * INCH * 2400 + 12 * INCH * 760)
     assert b.block_mass == pytest.approx(expected)
+
+
+#: One pound-force per square inch [Pa], from the exact definitions of the pound, g and the inch.
+PSI = 0.45359237 * 9.80665 / INCH**2
+
+
+def test_oak_cap_defaults_are_the_wood_handbook_values():
+    """White oak, 12 % moisture content, Wood Handbook 2010 (FPL-GTR-190): the metric table
+    (5-3a) and the inch-pound table (5-3b) agree to their rounding; E_T = 0.072 x 1.1 x E_bending
+    (Table 5-1 ratio, Table 5-3 footnote: +10 % for shear deflection)."""
+    cap = Cap()
+    assert cap.proportional_limit == 7.4e6
+    assert cap.proportional_limit == pytest.approx(1070 * PSI, rel=0.005)   # Table 5-3b
+    assert P.WHITE_OAK_BENDING_MODULUS == pytest.approx(1.78e6 * PSI, rel=0.005)
+    assert cap.modulus == pytest.approx(0.072 * 1.10 * 12.3e9, rel=1e-12)
+    assert cap.modulus == pytest.approx(0.974e9, rel=1e-3)
+    # density from specific gravity 0.68 (oven-dry mass, volume at 12 %) plus 12 % water
+    assert P.OAK_DENSITY == pytest.approx(0.68 * 1.12 * 1000.0, rel=0.005)
+
+
+def test_navy_block_is_the_described_standard_block():
+    """42 x 48 in plan, 48 in overall, caps of 6 in oak timbers top and bottom (SBIR N254-122,
+    after UFC 4-213-10 Fig. 8-2); its 330 LT load leaves the caps elastic, even green."""
+    b = NAVY_BLOCK
+    plan = sorted((b.length / INCH, 2 * b.half_width / INCH))
+    assert plan == pytest.approx([42.0, 48.0])
+    assert 2 * b.half_height / INCH == pytest.approx(48.0)
+    assert b.top.thickness / INCH == pytest.approx(6.0) == b.bottom.thickness / INCH
+    pressure = b.capacity / (b.length * 2 * b.half_width)
+    assert pressure == pytest.approx(330 * 2240 / (42 * 48) * PSI)
+    assert pressure < 670 * PSI < b.top.proportional_limit   # green white oak, Table 5-3b
 
 
 def test_line_stiffness_is_n_blocks_times_e_a_over_t():

@@ -36,13 +36,12 @@ def _processing_chain(spec):
         return []
     if spec == "demean":
         return [{"step": "demean"}]
-    import tomllib
+    from shipblock.checks import toml_file
 
     path = Path(spec)
     if not path.exists():
         raise UserError(f"processing chain file {spec} does not exist")
-    with open(path, "rb") as fh:
-        data = tomllib.load(fh)
+    data = toml_file(path, "processing chain file")
     chain = data.get("processing")
     if isinstance(chain, dict):
         chain = chain.get("chain", chain.get("steps"))

@@ -86,14 +86,9 @@ def record_text(motion, scale=None) -> str:
         e.g. ``"record south-napa-2014/NP.1765 (CA:Napa;FS 3): horizontal H1 = NP.1765..HNN
         (0 deg), event 2014-08-24 10:20:44 UTC Mw 6.02, scale factor 2.6"``.
     """
-    md = motion.metadata
-    station = md.get("station")
-    # GroundMotion.name gives the repr of from_arrays's station dict {"name": ...}
-    name = (station["name"] if isinstance(station, Mapping) and station.get("name")
-            and not (md.get("catalogue") or {}).get("id") else motion.name)
     start = motion.starttime
     start = str(start)[:19].replace("T", " ") if start.year > 1970 else None
-    return record_line(name, md, start, scale)
+    return record_line(motion.name, motion.metadata, start, scale)
 
 
 def record_line(name, metadata, start=None, scale=None) -> str:

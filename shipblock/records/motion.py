@@ -336,19 +336,23 @@ class GroundMotion:
 
     @property
     def name(self) -> str:
-        """Short name: the catalogue id, else NET.STA, else the name given to :meth:`from_arrays`,
-        else the first file's name (a file that states no codes, e.g. an SMC file of type
-        ``0 UNKNOWN``)."""
+        """Short name: the catalogue id, else NET.STA, else the name given to :meth:`from_arrays`
+        (as given: it is a label, not a file), else the first file's name (a file that states no
+        codes, e.g. an SMC file of type ``0 UNKNOWN``), else ``"record"``; never a dict's repr."""
         md = self._metadata
         cat = md.get("catalogue") or {}
         if cat.get("id"):
             return str(cat["id"])
         st = md.get("station")
-        if isinstance(st, dict) and (st.get("network") or st.get("station")):
+        if not isinstance(st, Mapping):
+            return str(st or md.get("name") or "record")
+        if st.get("network") or st.get("station"):
             return ".".join(code for code in (st.get("network"), st.get("station")) if code)
-        if isinstance(st, dict) and md.get("source_files"):
+        if st.get("name"):
+            return str(st["name"])
+        if md.get("source_files"):
             return os.path.basename(str(md["source_files"][0]))
-        return str(st or md.get("name") or "record")
+        return str(md.get("name") or "record")
 
     @property
     def metadata(self) -> dict:

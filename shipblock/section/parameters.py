@@ -4,18 +4,24 @@ Everything a dock engineer has for a docking plan, in SI units, each value range
 its key named (the style of :mod:`shipblock.checks`). Stiffnesses are derived from the cap's
 modulus across the grain, its loaded area and its thickness unless given.
 
-Defaults are the standard US Navy keel block with white-oak caps:
+Defaults are the standard US Navy keel block with white-oak caps. Each value, its source and
+what was *not* found are in ``docs/theory/section.md`` (table "Parameters and defaults"):
 
-* block 42 x 48 x 48 in (UFC 4-213-10, *Graving Drydocks*, the standard keel block); this module
-  reads it as 42 in along the keel, 48 in across the dock and 48 in tall overall (caps included);
-  check that reading against your docking drawing;
-* oak caps 6 in thick, top and bottom (the block is concrete capped top and bottom with
-  white-oak timbers);
-* white oak at 12 % moisture content (USDA Forest Products Laboratory, *Wood Handbook*, 2010,
-  Table 4-3b and the elastic ratios of Table 4-1): compression perpendicular to the grain at the
-  proportional limit 7.4 MPa; modulus across the grain E_T = 0.072 E_L with E_L = 12.3 GPa,
-  that is 0.886 GPa (a flat-sawn cap is loaded in its tangential direction);
-* block capacity 330 long tons (the order of published Navy block capacities).
+* block 42 x 48 in in plan and 48 in tall overall, concrete capped top and bottom with three
+  48 x 6 x 14 in white-oak timbers, so caps 6 in thick (NAVFAC, Navy SBIR topic N254-122,
+  2025, which points to UFC 4-213-10 *Graving Drydocks*, Figure 8-2, for the standard drawing;
+  the figure itself was not read). Which of 42 and 48 in lies along the keel is not stated
+  there; this module reads 42 in along the keel and 48 in across the dock: check it against
+  your docking drawing;
+* white oak, clear wood at 12 % moisture content, USDA Forest Products Laboratory, *Wood
+  Handbook*, FPL-GTR-190 (2010), Chapter 5: compression perpendicular to the grain (fibre
+  stress at the proportional limit) 7,400 kPa (Table 5-3a; 1,070 lbf/in^2 in Table 5-3b);
+  static-bending modulus 12,300 MPa (1.78e6 lbf/in^2), which Table 5-3's footnote says to
+  raise by 10 % to remove shear deflection, so E_L = 13.5 GPa; E_T / E_L = 0.072 (Table 5-1),
+  so E_T = 0.974 GPa (a flat-sawn cap is loaded in its tangential direction). Green wood (a
+  soaked cap) is softer and weaker: 4,600 kPa and 8,600 MPa;
+* block capacity 330 long tons force: the load the Navy asks a replacement cap to carry for
+  five years (SBIR topic N254-122); no rated block capacity was found in the documents read.
 
 The friction coefficients, the damping ratio and the ratio of tangential to normal cap stiffness
 are model parameters with typical values, not handbook data; give your own.
@@ -41,11 +47,24 @@ __all__ = [
     "Wind",
 ]
 
-#: Density of the concrete of a block [kg/m^3] (normal-weight concrete).
+#: Density of the concrete of a block [kg/m^3]: the usual value for plain normal-weight concrete
+#: (150 lb/ft^3); not taken from a Navy document.
 CONCRETE_DENSITY = 2400.0
-#: Density of white oak at 12 % moisture content [kg/m^3] (specific gravity 0.68, Wood Handbook
-#: Table 4-3b, times 1.12 for the water).
+#: Density of white oak at 12 % moisture content [kg/m^3]: specific gravity 0.68 (oven-dry mass,
+#: volume at 12 %; Wood Handbook 2010, Table 5-3a) times 1.12 for the water, 762 kg/m^3.
 OAK_DENSITY = 760.0
+#: White oak, clear wood, 12 % moisture content (Wood Handbook 2010, FPL-GTR-190, Table 5-3a):
+#: static-bending modulus of elasticity [Pa] and compression perpendicular to the grain, fibre
+#: stress at the proportional limit [Pa].
+WHITE_OAK_BENDING_MODULUS = 12.3e9
+WHITE_OAK_PROPORTIONAL_LIMIT = 7.4e6
+#: Table 5-3 footnote: the bending modulus includes shear deflection; raise it by 10 % for E_L.
+SHEAR_FREE_FACTOR = 1.10
+#: Elastic ratio E_T / E_L of white oak at about 12 % moisture content (Wood Handbook 2010,
+#: Table 5-1).
+WHITE_OAK_ET_OVER_EL = 0.072
+#: Modulus of white oak across the grain, tangential direction [Pa]: 0.072 * 1.10 * 12.3 GPa.
+WHITE_OAK_MODULUS_T = WHITE_OAK_ET_OVER_EL * SHEAR_FREE_FACTOR * WHITE_OAK_BENDING_MODULUS
 #: Steepest hull slope a block top can be cut to [rad]: beyond 45 deg the normal force on the cap
 #: pushes the block sideways harder than down (a shore, not a block).
 MAX_HULL_SLOPE = math.radians(45.0)
@@ -79,24 +98,28 @@ class Cap:
     thickness : float
         Cap thickness t [m]; default 6 in.
     modulus : float
-        Modulus of the cap across the grain E_perp [Pa]; default 0.886 GPa (white oak, E_T).
+        Modulus of the cap across the grain E_perp [Pa]; default 0.974 GPa (white oak at 12 %,
+        E_T = 0.072 E_L with E_L = 1.1 x 12.3 GPa; Wood Handbook 2010, Tables 5-1 and 5-3a).
     proportional_limit : float
         Compression perpendicular to the grain at the proportional limit sigma_pl [Pa]; beyond it
-        the cap crushes (perfectly plastic) and keeps the set; default 7.4 MPa (white oak, 12 %).
+        the cap crushes (perfectly plastic) and keeps the set; default 7.4 MPa (white oak at 12 %,
+        Wood Handbook 2010, Table 5-3a; green wood 4.6 MPa).
     stiffness : float or None
         Normal stiffness of one block's cap [N/m]; None derives ``modulus * area / thickness``.
     damping_ratio : float
         Viscous damping ratio of the cap's normal mode with the mass it carries at rest [-]
         (:mod:`shipblock.section.model` says which mode exactly); default 0.1.
     mu_s, mu_k : float
-        Static and kinetic Coulomb friction on this face [-]; defaults 0.5 and 0.4.
+        Static and kinetic Coulomb friction on this face [-]; defaults 0.5 and 0.4 (inside the
+        0.2-0.6 of general tables for wood on metal; no source for oak caps on a hull or on
+        concrete was found).
     shear_ratio : float
         Stiffness of the tangential stick spring over the normal stiffness [-]; default 0.5.
     """
 
     thickness: float = 6.0 * INCH
-    modulus: float = 0.072 * 12.3e9
-    proportional_limit: float = 7.4e6
+    modulus: float = WHITE_OAK_MODULUS_T
+    proportional_limit: float = WHITE_OAK_PROPORTIONAL_LIMIT
     stiffness: float | None = None
     damping_ratio: float = 0.1
     mu_s: float = 0.5
@@ -140,7 +163,8 @@ class Block:
     mass : float or None
         Mass of one block [kg]; None: concrete between the caps plus oak caps.
     capacity : float
-        Rated load of one block [N]; default 330 long tons force.
+        Rated load of one block [N]; default 330 long tons force (the load a Navy block cap is
+        asked to carry, SBIR topic N254-122; not a rated capacity from a standard).
     top, bottom : Cap
         Cap under the hull and on the floor; default white-oak caps 6 in thick.
     """
