@@ -89,6 +89,7 @@ def cmd_plot(args):
         raise UserError(f"{args.results}: neither a simulation response nor a fragility result")
     from shipblock.plot import (
         check_edp,
+        default_edp,
         plot_fragility,
         plot_ida,
         plot_median_sweep,
@@ -100,11 +101,12 @@ def cmd_plot(args):
     except ValueError as exc:
         raise UserError(f"{args.results}: --set {exc}") from None
     if args.kind == "ida":
+        edp = default_edp(ds) if args.edp is None else args.edp
         try:
-            check_edp(ds, args.edp, "--edp")
+            check_edp(ds, edp, "--edp")
         except ValueError as exc:
             raise UserError(f"{args.results}: {exc}") from None
-        _save_figure(lambda: plot_ida(ds, args.edp, sweep=sweep).figure, figure)
+        _save_figure(lambda: plot_ida(ds, edp, sweep=sweep).figure, figure)
     elif args.kind == "median":
         if not sweep:
             raise UserError(f"{args.results}: --kind median needs a study with a [sweep]")

@@ -45,7 +45,8 @@ from shipblock.plot.response import (
 )
 # The study figures load on first use: shipblock.fragility imports the solver, which a command
 # that draws a response or a record must not import (nor compile).
-_STUDY = ("DODGE", "MARKER_SIZE", "MARKER_STEP", "check_edp", "limit_state_text", "marker_sizes",
+_STUDY = ("DODGE", "MARKER_SIZE", "MARKER_STEP", "check_edp", "default_edp", "limit_state_text",
+          "marker_sizes",
           "plot_fragility", "plot_ida", "plot_median_sweep", "study_caption", "sweep_selection",
           "sweep_text")
 
@@ -76,6 +77,7 @@ __all__ = [
     "active_window",
     "check_edp",
     "dataset_record_line",
+    "default_edp",
     "limit_state_text",
     "marker_sizes",
     "mode_spans",
