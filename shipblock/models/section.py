@@ -492,10 +492,13 @@ class SectionRun:
         energy balance).
     summary : dict
         The model's outputs of the run (:data:`RUN_VARIABLES`), equal to the batch's.
+    ground : numpy.ndarray, shape (n, 2)
+        The ground acceleration the run was given, horizontal and vertical [m/s^2].
     """
 
     result: SectionResult
     summary: dict
+    ground: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
 
     @property
     def events(self) -> list:
@@ -517,8 +520,19 @@ class SectionRun:
         <shipblock.section.simulate.SectionResult.to_dataset>`) with the model's outputs as
         attributes (``failure`` as its code, ``failure_name`` its name)."""
         ds = self.result.to_dataset()
+        ds["time"].attrs["long_name"] = "time from the start of the record"
+        n = ds.sizes["time"]
+        if self.ground.shape[0] >= n:
+            for k, (name, what) in enumerate((("h", "horizontal, positive to starboard"),
+                                              ("v", "vertical, positive up"))):
+                ds[f"ground_acceleration_{name}"] = ("time", self.ground[:n, k], {
+                    "units": "m/s^2", "long_name": f"ground acceleration, {what}"})
+        sec = self.result.section
+        lines = {"keel": sec.keel, **{f"side{i}": line for i, line in enumerate(sec.sides)}}
         ds.attrs = {**self.summary, "failure_name": self.result.failure or "none",
-                    "model": SectionModel.name}
+                    "model": SectionModel.name, "keel_cap_half_width": sec.keel.block.half_width,
+                    **{f"{name}_block_capacity": line.block.capacity
+                       for name, line in lines.items()}}
         return ds
 
 
@@ -641,4 +655,6 @@ class SectionModel(Model):
                  **options) -> SectionRun:
         """One run with its histories (:func:`~shipblock.section.simulate_section`)."""
         result = simulate_section(system.section, horizontal, vertical, dt, **options)
-        return SectionRun(result, outputs(system.section, result))
+        h = np.asarray(horizontal, dtype=float)
+        v = np.zeros_like(h) if vertical is None else np.asarray(vertical, dtype=float)
+        return SectionRun(result, outputs(system.section, result), np.column_stack([h, v]))

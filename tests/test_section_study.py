@@ -1,0 +1,330 @@
+"""Studies on the dock-section model (``[system] model = "section"``, issue 30).
+
+A small ship on two keel blocks, on short synthetic records (6 s at 100 Hz), through the same
+pipeline machinery as the rigid model: IDA with a sweep, capacity and failure limit states,
+fits, resume after an interruption, histories, reruns and figures. The checks are physics and
+invariants:
+
+* at a weak, static-like motion the capacity ratio is the static load per block over the
+  capacity and the keel cap's peak pressure the trapezoid of the moment-area hand calculation
+  (the ship's G off the centre line), as in ``tests/test_section_static.py``;
+* a limit state on a failure kind is exceeded exactly by the runs that ended in that failure,
+  and collapse exceeds every response limit state;
+* a resumed study equals the uninterrupted one exactly; a rerun equals the batch's run.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from shipblock.fragility import batch as batch_mod
+from shipblock.fragility.keys import key_table
+from shipblock.fragility.pipeline import PipelineError, load_pipeline, rerun_case, run_pipeline
+from shipblock.models import FieldError, get_model
+from shipblock.models.section import FAILURE_CODES, FAILURE_FLAGS
+from shipblock.units import STANDARD_GRAVITY as G
+
+from .test_batch import make_catalogue, synthetic_motion
+
+# a 30 t ship on two narrow keel blocks: it tips off the keel line at about 1 g on these
+# records (tip angle atan(0.15 / 1.5) = 0.1 rad) and slides on low friction
+SYSTEM = """
+[system]
+model = "section"
+ship_mass = "30 t"
+roll_radius = "1 m"
+g_height = "1.5 m"
+keel_half_width = "150 mm"
+half_beam = "3 m"
+keel_blocks = 2
+side_lines = 0
+block_half_width = "150 mm"
+mu_s_top = 0.1
+mu_k_top = 0.08
+mu_s_bottom = 0.8
+mu_k_bottom = 0.7
+"""
+
+PIPELINE = """
+schema_version = 1
+title = "section test"
+output = "out/section.nc"
+processing = []
+
+[records]
+catalogue = "records/catalogue.toml"
+ids = "all"
+horizontal = "H1"
+{system}
+{sweep}
+[design]
+type = "ida"
+levels_g = [0.2, 0.4, 0.6, 0.8, 1.0, 1.5]
+vertical = "zero"
+max_scale_factor = 20.0     # the synthetic records peak at about 1 m/s^2
+
+[[limit_states]]
+name = "keel_capacity"
+edp = "keel_load_ratio"
+threshold = 0.12
+
+[[limit_states]]
+name = "tipped"
+edp = "tipped_off"
+condition = "nonzero"
+
+[[limit_states]]
+name = "slid"
+edp = "failure"
+condition = "equal"
+threshold = 3
+
+[[limit_states]]
+name = "offset"
+edp = "sway_ratio"
+threshold = 0.1
+
+[fit]
+bootstrap = 10
+seed = 5
+
+[execution]
+chunk_size = 9
+
+[histories]
+runs = [{{record = "S1", im_level_g = 1.0, mu_top = 0.1}}]
+"""
+
+SWEEP = "[sweep]\nmu_top = [0.1, 0.3]\n"
+
+
+def write(tmp_path, system=SYSTEM, sweep=SWEEP, name="section.toml", **replace):
+    if not (tmp_path / "records" / "catalogue.toml").exists():
+        make_catalogue(tmp_path / "records", n_records=3)
+    text = PIPELINE.format(system=system, sweep=sweep)
+    for old, new in replace.items():
+        text = text.replace(old, new)
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("section")
+    path = write(tmp)
+    return tmp, path, run_pipeline(path, progress=False)
+
+
+def test_a_section_study_runs_the_section_model(study):
+    _, path, ds = study
+    assert load_pipeline(path).model is get_model("section")
+    assert ds.attrs["model"] == "section"
+    assert ds["keel_load_ratio"].dims == ("record", "im_level", "mu_top")
+    assert ds["keel_load_ratio"].attrs["units"] == "1"
+    assert ds["crushing_set"].attrs["units"] == "m"
+    assert "peak_ship_slip" not in ds
+    # the given quantities reached the model in SI
+    system = json.loads(ds.attrs["system"])
+    assert system["ship_mass"] == 3e4 and system["keel_half_width"] == pytest.approx(0.15)
+    failure = ds["failure"].values
+    assert np.isfinite(failure).all() and set(np.unique(failure)) <= set(FAILURE_CODES)
+    # the study has survivors and failures (a fit needs both)
+    assert (failure == 0).any() and (failure == 4).any()
+    # every run balances its energy (or stopped at a failure with its balance so far)
+    assert np.nanmax(np.abs(ds["energy_residual"].values)) < 1e-3
+    # each failure kind's boolean EDP is its code
+    for name, code in FAILURE_FLAGS.items():
+        np.testing.assert_array_equal(ds[name].values, (failure == code).astype(float))
+    # a stronger friction on the keel caps: the ship sways less on them (no run of the
+    # stronger friction sways more at the two lower levels, where no run fails)
+    low = ds["peak_sway"].isel(im_level=[0, 1, 2])
+    assert (low.sel(mu_top=0.3) <= low.sel(mu_top=0.1) + 1e-9).all()
+
+
+def test_limit_states_on_failure_kinds_count_exactly_the_failed_runs(study):
+    _, _, ds = study
+    failure = ds["failure"]
+    tipped = ds["exceeded"].sel(limit_state="tipped")
+    slid = ds["exceeded"].sel(limit_state="slid")
+    np.testing.assert_array_equal(tipped.values, (failure == 4).transpose(*tipped.dims).values)
+    np.testing.assert_array_equal(slid.values, (failure == 3).transpose(*slid.dims).values)
+    assert int(tipped.sum()) > 0
+    # collapse exceeds every response limit state, here the capacity and offset ones
+    for name in ("keel_capacity", "offset"):
+        exceeded = ds["exceeded"].sel(limit_state=name)
+        collapsed = (failure != 0).transpose(*exceeded.dims)
+        assert exceeded.values[collapsed.values].all()
+        # and a survivor exceeds exactly when its EDP is above the threshold
+        edp = ds[str(ds["limit_state_edp"].sel(limit_state=name).values)]
+        threshold = float(ds["limit_state_threshold"].sel(limit_state=name))
+        above = (edp > threshold).transpose(*exceeded.dims).values
+        np.testing.assert_array_equal(exceeded.values[~collapsed.values],
+                                      above[~collapsed.values])
+    # every limit state was fitted per swept friction
+    assert ds["median"].dims == ("limit_state", "mu_top")
+    assert np.isfinite(ds["median"].sel(limit_state="tipped")).all()
+
+
+def test_the_history_and_a_rerun_equal_the_batch_run(study):
+    tmp, path, ds = study
+    (history,) = [f for f in ds["history_file"].values.ravel() if f]
+    batch = ds.sel(record="syn/S1", mu_top=0.1).isel(im_level=4)
+    with xr.open_dataset(tmp / "out" / history) as h:
+        assert h.attrs["model"] == "section"
+        assert float(np.abs(h["ship_roll"]).max()) == float(batch["peak_roll"])
+        assert h.attrs["keel_load_ratio"] == float(batch["keel_load_ratio"])
+    res = rerun_case(path, "S1", im_level_g=1.0, mu_top=0.1)
+    for name in ("keel_load_ratio", "peak_sway", "crushing_set", "failure"):
+        assert res.summary[name] == float(batch[name]), name
+
+
+def test_resume_after_an_interruption_gives_the_same_result(study, tmp_path, monkeypatch):
+    _, _, full = study
+    path = write(tmp_path)
+    real = batch_mod.run_chunk
+    calls = []
+
+    def interrupted(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt  # in the third chunk of four
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(batch_mod, "run_chunk", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_pipeline(path, progress=False)
+    assert len(list((tmp_path / "out" / "section.nc.partial").glob("chunk-*.npz"))) == 2
+    calls.clear()
+    monkeypatch.setattr(batch_mod, "run_chunk",
+                        lambda *a, **k: (calls.append(1), real(*a, **k))[1])
+    resumed = run_pipeline(path, progress=False)
+    assert len(calls) == 2  # 36 runs in chunks of 9: the last two chunks only
+    # every number equal; of the attributes, only those naming the (other) folder differ
+    xr.testing.assert_identical(full.drop_attrs(deep=False).drop_vars("history_file"),
+                                resumed.drop_attrs(deep=False).drop_vars("history_file"))
+    paths = ("created", "pipeline_source", "catalogue", "records_provenance",
+             "pipeline_fingerprint", "histories_directory")
+    assert {k: v for k, v in full.attrs.items() if k not in paths} == {
+        k: v for k, v in resumed.attrs.items() if k not in paths}
+
+
+def test_the_capacity_ratio_of_a_weak_motion_is_the_static_hand_value():
+    """Keel line alone, G 5 cm off the centre line, a motion of 1e-5 m/s^2 (static-like: its
+    inertia moment m a h_G is 1e-6 of the weight's W e): the load per block is W / n, on the
+    Navy block's oak caps and on stiff ones. On stiff caps (E = 1e11 Pa, so that the roll and
+    its moment W h_G phi stay ~1e-5 of W e) the keel cap's peak pressure is the trapezoid
+    P/A + P e b / I (inside the kern), whose moment part is a quarter of it here."""
+    model = get_model("section")
+    values = {"ship_mass": 3e5, "roll_radius": 2.0, "g_height": 2.0, "keel_half_width": 2.0,
+              "half_beam": 5.0, "keel_blocks": 2, "side_lines": 0, "g_offset": 0.05}
+    systems = [model.build(values), model.build({**values, "cap_modulus": 1e11})]
+    h1, _, _, dt = synthetic_motion(0)
+    weak = 1e-5 * h1 / np.abs(h1).max()
+    out = model.run_batch(systems, [(weak, None)], [dt], np.array([[0, 0], [0, 1]]))
+    block = systems[0].section.keel.block
+    load = values["ship_mass"] * G / values["keel_blocks"]
+    np.testing.assert_allclose(out["keel_load_ratio"], load / block.capacity, rtol=1e-6)
+    np.testing.assert_allclose(out["keel_peak_load_per_block"], load, rtol=1e-6)
+    b, length = block.half_width, block.length
+    area, inertia = 2 * b * length, length * (2 * b) ** 3 / 12
+    pressure = load / area + load * values["g_offset"] * b / inertia
+    assert out["keel_peak_top_pressure_ratio"][1] == pytest.approx(
+        pressure / block.top.proportional_limit, rel=1e-4)
+    # on compliant caps the ship rolls towards G and its weight's lever grows (P-delta): the
+    # peak pressure is higher than the rigid trapezoid, never lower
+    assert out["keel_peak_top_pressure_ratio"][0] > pressure / block.top.proportional_limit
+    assert (out["failure"] == 0).all() and (out["crushing_set"] == 0).all()
+    assert (out["side_load_ratio"] == 0).all() and np.isnan(out["side0_capacity_ratio"]).all()
+
+
+def test_a_run_that_raises_is_a_solver_error_row_and_the_others_are_kept(monkeypatch):
+    model = get_model("section")
+    system = model.build({"ship_mass": 3e5, "roll_radius": 2.0, "g_height": 2.0,
+                          "keel_half_width": 2.0, "half_beam": 5.0, "keel_blocks": 2,
+                          "side_lines": 0})
+    h1, _, _, dt = synthetic_motion(1)
+    good = 0.5 * h1
+    bad = good.copy()
+    bad[10] = np.nan  # refused by the section's input checks
+    out = model.run_batch([system], [(good, None), (bad, None)], [dt, dt],
+                          np.array([[0, 0], [1, 0], [0, 0]]))
+    assert list(out["failure"]) == [0.0, 6.0, 0.0]
+    assert np.isnan(out["keel_load_ratio"][1]) and out["keel_load_ratio"][0] > 0
+    assert out["keel_load_ratio"][0] == out["keel_load_ratio"][2]
+
+
+@pytest.mark.parametrize(("edit", "key", "needle"), [
+    (('g_height = "1.5 m"', 'g_height = "-1 m"'), "system.g_height", "(0, 100]"),
+    (('half_beam = "3 m"', 'half_beam = "3 kg"'), "system.half_beam", "m"),
+    (("keel_blocks = 2", "keel_blocks = 2\nkeel_block = 3"), "system.keel_block",
+     "keel_blocks"),
+    (("mu_k_top = 0.08", "mu_k_top = 0.2"), "system.mu_k_top", "mu_s_top"),
+    (('roll_radius = "1 m"', 'roll_radius = "1 m"\nroll_inertia = 3e4'), "system.roll_inertia",
+     "roll_radius"),
+    (("side_lines = 0", "side_lines = 2\nside_blocks = 2"), "system.side_offset", "missing"),
+    (("side_lines = 0", "side_lines = 2\nside_blocks = 2\nside_offset = 2.95"),
+     "system.side_offset", "not under the hull"),
+    (("keel_blocks = 2", "keel_blocks = 2\ncap_thickness = 0.7"), "system.cap_thickness",
+     "thicker than the block"),
+    (("keel_blocks = 2", "keel_blocks = 2\ncap_proportional_limit = 2e5"), "system.keel_blocks",
+     "crush"),
+    (("mu_top = [0.1", "side_moving = [0.1"), "sweep.side_moving", "allowed keys"),
+    (("mu_top = [0.1, 0.3]", "mu_top = [0.1, 0.3]\nkeel_blocks = [2.5]"), "sweep.keel_blocks",
+     "whole number"),
+    (('edp = "keel_load_ratio"', 'edp = "peak_ship_slip"'), "limit_states", "keel_load_ratio"),
+])
+def test_bad_system_keys_are_named(tmp_path, edit, key, needle):
+    path = write(tmp_path, **{edit[0]: edit[1]})
+    with pytest.raises(PipelineError) as info:
+        load_pipeline(path)
+    assert info.value.key == key, str(info.value)
+    assert needle in str(info.value), str(info.value)
+
+
+def test_the_build_errors_name_the_parameter():
+    model = get_model("section")
+    base = {"ship_mass": 3e5, "roll_radius": 2.0, "g_height": 2.0, "keel_half_width": 2.0,
+            "half_beam": 5.0, "keel_blocks": 2, "side_lines": 0}
+    with pytest.raises(FieldError) as info:
+        model.build({**base, "g_offset": 6.0})  # in its range, beyond the beam
+    assert info.value.field == "g_offset"
+    with pytest.raises(FieldError) as info:
+        model.build({k: v for k, v in base.items() if k != "ship_mass"})
+    assert info.value.field == "ship_mass"
+
+
+def test_the_key_table_lists_the_section_keys():
+    table = key_table("section")
+    for key in ("system.ship_mass", "system.side_offset", "system.cap_modulus",
+                "sweep.mu_top", "solver.separation_height"):
+        assert f"``{key}``" in table, key
+    assert "``system.n_blocks``" not in table
+
+
+def test_figures_of_a_section_study(study, tmp_path):
+    from shipblock.cli import main
+    from shipblock.plot import plot_ida, plot_median_sweep, study_caption
+
+    tmp, path, ds = study
+    caption = study_caption(ds, {"mu_top": 0.3})
+    assert "30 t" in caption[1] and "friction top 0.3/0.24" in caption[1]
+    ax = plot_ida(ds)
+    assert "peak load per keel block" in ax.get_xlabel()
+    ax = plot_median_sweep(ds, "mu_top", limit_state="tipped")
+    line = [ln for ln in ax.get_lines() if len(ln.get_xdata()) == 2][0]
+    np.testing.assert_allclose(line.get_xdata(), [0.1, 0.3])
+    np.testing.assert_allclose(line.get_ydata(),
+                               ds["median"].sel(limit_state="tipped").values / G, rtol=1e-12)
+    (history,) = [f for f in ds["history_file"].values.ravel() if f]
+    png = tmp_path / "h.png"
+    assert main(["-q", "plot", str(tmp / "out" / history), "--figure", str(png)]) == 0
+    assert png.stat().st_size > 0
+    assert main(["-q", "plot", str(tmp / "out" / "section.nc"), "--kind", "median",
+                 "--figure", str(tmp_path / "m.png")]) == 0
+    assert main(["-q", "history", str(path), "--record", "S0", "--im-level-g", "1.5",
+                 "--set", "mu_top=0.3", "--figure", str(tmp_path / "r.png")]) == 0
