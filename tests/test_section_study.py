@@ -26,6 +26,7 @@ from shipblock.fragility.keys import key_table
 from shipblock.fragility.pipeline import PipelineError, load_pipeline, rerun_case, run_pipeline
 from shipblock.models import FieldError, get_model
 from shipblock.models.section import FAILURE_CODES, FAILURE_FLAGS
+from shipblock.section import NAVY_BLOCK
 from shipblock.units import STANDARD_GRAVITY as G
 
 from .test_batch import make_catalogue, synthetic_motion
@@ -144,6 +145,25 @@ def test_a_section_study_runs_the_section_model(study):
     # stronger friction sways more at the two lower levels, where no run fails)
     low = ds["peak_sway"].isel(im_level=[0, 1, 2])
     assert (low.sel(mu_top=0.3) <= low.sel(mu_top=0.1) + 1e-9).all()
+
+
+@pytest.mark.parametrize("design", ['type = "msa"\nlevels_g = [0.3, 1.0]',
+                                    'type = "cloud"\ncloud_method = "probit"'])
+def test_msa_and_cloud_designs_run_the_section_model(tmp_path, design):
+    path = write(tmp_path, sweep="", **{
+        'type = "ida"\nlevels_g = [0.2, 0.4, 0.6, 0.8, 1.0, 1.5]': design,
+        "[histories]": "", 'runs = [{record = "S1", im_level_g = 1.0, mu_top = 0.1}]': ""})
+    ds = run_pipeline(path, progress=False)
+    assert ds.attrs["design_type"] == design.split('"')[1]
+    ratio = ds["keel_load_ratio"]
+    assert ratio.dims == (("record", "im_level") if "msa" in design else ("record",))
+    # the keel blocks carry at least their static share of the weight at some instant (the
+    # run starts from it), and the load per block is the ratio times the capacity
+    static = 3e4 * G / 2 / NAVY_BLOCK.capacity  # the Navy block's rated load, the default
+    assert (ratio.values >= static * (1 - 1e-9)).all()
+    np.testing.assert_allclose(ds["keel_peak_load_per_block"] / ratio, NAVY_BLOCK.capacity,
+                               rtol=1e-12)
+    assert ds["exceeded"].sizes["limit_state"] == 4
 
 
 def test_limit_states_on_failure_kinds_count_exactly_the_failed_runs(study):
@@ -309,6 +329,7 @@ def test_the_key_table_lists_the_section_keys():
 def test_figures_of_a_section_study(study, tmp_path):
     from shipblock.cli import main
     from shipblock.plot import plot_ida, plot_median_sweep, study_caption
+    from shipblock.report_html import write_report
 
     tmp, path, ds = study
     caption = study_caption(ds, {"mu_top": 0.3})
@@ -328,3 +349,7 @@ def test_figures_of_a_section_study(study, tmp_path):
                  "--figure", str(tmp_path / "m.png")]) == 0
     assert main(["-q", "history", str(path), "--record", "S0", "--im-level-g", "1.5",
                  "--set", "mu_top=0.3", "--figure", str(tmp_path / "r.png")]) == 0
+    html, *_ = write_report(tmp / "out" / "section.nc", tmp_path / "report.html")
+    text = html.read_text()
+    assert "Model section" in text and "tipped off a support line" in text
+    assert "ship_mass" in text and "keel_load_ratio" in text
