@@ -353,3 +353,31 @@ def test_figures_of_a_section_study(study, tmp_path):
     text = html.read_text()
     assert "Model section" in text and "tipped off a support line" in text
     assert "ship_mass" in text and "keel_load_ratio" in text
+
+
+def test_the_model_and_its_systems_travel_to_dask_workers():
+    """A chunk task pickles the model and the systems (shipblock.fragility.workers): the
+    unpickled ones give the same run bit for bit."""
+    import pickle
+
+    model = get_model("section")
+    system = model.build({"ship_mass": 3e5, "roll_radius": 2.0, "g_height": 2.0,
+                          "keel_half_width": 2.0, "half_beam": 5.0, "keel_blocks": 2,
+                          "side_lines": 0})
+    h1, _, _, dt = synthetic_motion(2)
+    twin, twin_system = pickle.loads(pickle.dumps((model, system)))
+    a = model.run_batch([system], [(0.5 * h1, None)], [dt], np.array([[0, 0]]))
+    b = twin.run_batch([twin_system], [(0.5 * h1, None)], [dt], np.array([[0, 0]]))
+    assert a.keys() == b.keys()
+    for name in a:
+        np.testing.assert_array_equal(a[name], b[name])
+
+
+def test_the_user_guide_names_every_edp():
+    from pathlib import Path
+
+    from shipblock.models.section import EDP_VARIABLES
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "user_guide" / "section.rst").read_text()
+    missing = [name for name in EDP_VARIABLES if f"``{name}``" not in text]
+    assert not missing
