@@ -381,3 +381,25 @@ def test_the_user_guide_names_every_edp():
     text = (Path(__file__).resolve().parents[1] / "docs" / "user_guide" / "section.rst").read_text()
     missing = [name for name in EDP_VARIABLES if f"``{name}``" not in text]
     assert not missing
+
+
+def test_the_risk_over_a_docking_period_of_a_section_study(study, tmp_path):
+    """The risk of a section study is each fitted fragility convolved with the hazard, as for
+    the rigid model (shipblock.risk), from the command line."""
+    from shipblock.cli import main
+    from shipblock.risk import risk_integral
+
+    from .test_risk import PGA_CURVES, nshmp_rows
+
+    tmp, _, ds = study
+    out_path = tmp_path / "risk.nc"
+    assert main(["-q", "risk", str(tmp / "out" / "section.nc"), "--hazard", str(PGA_CURVES),
+                 "--site", "San Francisco CA", "--days", "120", "--no-band", "-o",
+                 str(out_path)]) == 0
+    levels, lam = nshmp_rows(PGA_CURVES)["San Francisco CA"]
+    fitted = np.isfinite(ds["median"].values)
+    with xr.open_dataset(out_path) as risk:
+        rate = risk["risk_annual_rate"].transpose(*ds["median"].dims).values
+    np.testing.assert_allclose(rate[fitted], risk_integral(
+        levels * G, lam, ds["median"].values[fitted], ds["beta"].values[fitted]).annual_rate,
+        rtol=1e-12)

@@ -73,8 +73,13 @@ from shipblock.errors import ParameterError, ShipblockError
 from shipblock.models.base import EDPInfo, Field, FieldError, Model
 from shipblock.section import NAVY_BLOCK, Block, BlockLine, Cap, DockSection, Ship, Wind
 from shipblock.section.model import assemble, static_state
-from shipblock.section.parameters import MAX_BLOCKS, MAX_HULL_SLOPE, MAX_SIDE_LINES, \
-    SPRING_COUNTS
+from shipblock.section.parameters import (
+    MAX_BLOCKS,
+    MAX_HULL_SLOPE,
+    MAX_SIDE_LINES,
+    SPRING_COUNTS,
+    ZERO_ALLOWED,
+)
 from shipblock.section.simulate import (
     DEFAULT_ATOL,
     DEFAULT_MAX_EVENTS,
@@ -110,11 +115,9 @@ FAILURE_FLAGS: Mapping[str, int] = MappingProxyType({
 
 def _limited(name, limits, key, doc, units, quantity, default=None, **kw) -> Field:
     """A number field with the range of a section class's ``LIMITS`` entry ``key``."""
-    low, high, _, optional = limits[key]
-    from_zero = key in ("g_offset", "offset", "hull_height", "hull_slope", "mu_s", "mu_k",
-                        "damping_ratio", "force", "pressure", "area")
+    low, high, _, _ = limits[key]
     return Field(name, (float,), doc, units, default=default, low=low, high=high,
-                 low_open=low == 0.0 and not from_zero, quantity=quantity, **kw)
+                 low_open=low == 0.0 and key not in ZERO_ALLOWED, quantity=quantity, **kw)
 
 
 _CAP, _BLOCK, _SHIP = Cap(), NAVY_BLOCK, Ship.LIMITS
