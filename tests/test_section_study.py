@@ -349,6 +349,10 @@ def test_figures_of_a_section_study(study, tmp_path):
                  "--figure", str(tmp_path / "m.png")]) == 0
     assert main(["-q", "history", str(path), "--record", "S0", "--im-level-g", "1.5",
                  "--set", "mu_top=0.3", "--figure", str(tmp_path / "r.png")]) == 0
+    assert main(["-q", "export", str(tmp / "out" / "section.nc"), "--csv",
+                 str(tmp_path / "csv")]) == 0
+    header = (tmp_path / "csv" / "runs.csv").read_text().splitlines()[0]
+    assert "keel_load_ratio" in header and "crushing_set [m]" in header
     html, *_ = write_report(tmp / "out" / "section.nc", tmp_path / "report.html")
     text = html.read_text()
     assert "Model section" in text and "tipped off a support line" in text
