@@ -407,3 +407,14 @@ def test_the_risk_over_a_docking_period_of_a_section_study(study, tmp_path):
     np.testing.assert_allclose(rate[fitted], risk_integral(
         levels * G, lam, ds["median"].values[fitted], ds["beta"].values[fitted]).annual_rate,
         rtol=1e-12)
+
+
+def test_a_section_study_on_a_dask_cluster_equals_the_local_run(study, tmp_path):
+    from .test_pipeline import local_dask_client
+
+    _, path, local = study
+    with local_dask_client() as client:
+        remote = run_pipeline(path, output=tmp_path / "dask.nc", client=client, progress=False)
+    xr.testing.assert_identical(local.drop_attrs(deep=False).drop_vars("history_file"),
+                                remote.drop_attrs(deep=False).drop_vars("history_file"))
+    assert remote.attrs["system"] == local.attrs["system"]
