@@ -418,3 +418,27 @@ def test_a_section_study_on_a_dask_cluster_equals_the_local_run(study, tmp_path)
     xr.testing.assert_identical(local.drop_attrs(deep=False).drop_vars("history_file"),
                                 remote.drop_attrs(deep=False).drop_vars("history_file"))
     assert remote.attrs["system"] == local.attrs["system"]
+
+
+def test_a_sweep_over_the_number_of_side_lines_keeps_the_weight_on_the_blocks():
+    """Sweeping side_lines (0, 1, 2) from one table: at a static-like motion the lines' loads
+    per block times their blocks carry the ship's weight (vertical equilibrium), the side lines
+    take a share of it from the keel, and two symmetric lines share it equally."""
+    model = get_model("section")
+    base = model.build({"ship_mass": 3e5, "roll_radius": 2.0, "g_height": 2.0,
+                        "keel_half_width": 2.0, "half_beam": 5.0, "keel_blocks": 4,
+                        "side_blocks": 2, "side_offset": 3.5})
+    systems = [model.vary(base, {"side_lines": n}) for n in (0, 1, 2)]
+    assert [len(s.section.sides) for s in systems] == [0, 1, 2]
+    h1, _, _, dt = synthetic_motion(1)
+    weak = 1e-5 * h1 / np.abs(h1).max()
+    out = model.run_batch(systems, [(weak, None)], [dt], np.array([[0, 0], [0, 1], [0, 2]]))
+    weight = 3e5 * G
+    for k, n_sides in enumerate((0, 1, 2)):
+        carried = out["keel_peak_load_per_block"][k] * 4 + sum(
+            out[f"side{i}_peak_load_per_block"][k] * 2 for i in range(n_sides))
+        assert carried == pytest.approx(weight, rel=1e-4), n_sides
+    keel = out["keel_peak_load_per_block"]
+    assert keel[0] > keel[1] > keel[2]
+    assert out["side0_peak_load_per_block"][2] == pytest.approx(
+        out["side1_peak_load_per_block"][2], rel=1e-4)
