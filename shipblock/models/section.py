@@ -341,6 +341,8 @@ def _key_of(message: str, values: Mapping) -> str:
         return ""
     name = match.group(0)
     if name.startswith("DockSection.keel"):
+        if "friction" in message:
+            return "mu_s_top" if "top face" in message else "mu_s_bottom"
         return "keel_blocks" if "crush" in message else ""
     if name.startswith("DockSection.sides"):
         if name.endswith(".offset"):
