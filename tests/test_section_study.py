@@ -442,3 +442,35 @@ def test_a_sweep_over_the_number_of_side_lines_keeps_the_weight_on_the_blocks():
     assert keel[0] > keel[1] > keel[2]
     assert out["side0_peak_load_per_block"][2] == pytest.approx(
         out["side1_peak_load_per_block"][2], rel=1e-4)
+
+
+def test_every_parameter_at_its_bounds_builds_or_names_a_key():
+    """Each declared parameter set to the ends of its range, the others as in a small dock:
+    the section is built, or refused by a FieldError naming a [system] key (never another
+    error, never an unnamed one unless no single key is at fault)."""
+    from shipblock.models.section import PARAMETERS
+
+    model = get_model("section")
+    base = {"ship_mass": 3e5, "roll_radius": 2.0, "g_height": 2.0, "keel_half_width": 2.0,
+            "half_beam": 5.0, "keel_blocks": 4, "side_blocks": 2, "side_offset": 3.5}
+    built = refused = 0
+    for name, field in PARAMETERS.items():
+        for bound in (field.low, field.high):
+            if bound is None or bool in field.types:
+                continue
+            value = int(bound) if int in field.types and float not in field.types else bound
+            values = {**base, name: value}
+            if name == "roll_inertia":
+                values.pop("roll_radius")
+            if name in ("wind_pressure", "wind_area", "wind_force"):
+                values["wind_height"] = 5.0
+                if name != "wind_force":
+                    values.update(wind_pressure=values.get("wind_pressure", 100.0),
+                                  wind_area=values.get("wind_area", 10.0))
+            try:
+                model.build(values)
+                built += 1
+            except FieldError as exc:
+                assert exc.field in PARAMETERS or exc.field == "", (name, bound, str(exc))
+                refused += 1
+    assert built > 0 and refused > 0
