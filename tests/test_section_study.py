@@ -204,6 +204,8 @@ def test_the_history_and_a_rerun_equal_the_batch_run(study):
 
 
 def test_resume_after_an_interruption_gives_the_same_result(study, tmp_path, monkeypatch):
+    """Interrupted in its third chunk (Python), resumed by ``shipblock run``: equal to the
+    uninterrupted study, number for number."""
     _, _, full = study
     path = write(tmp_path)
     real = batch_mod.run_chunk
@@ -222,8 +224,12 @@ def test_resume_after_an_interruption_gives_the_same_result(study, tmp_path, mon
     calls.clear()
     monkeypatch.setattr(batch_mod, "run_chunk",
                         lambda *a, **k: (calls.append(1), real(*a, **k))[1])
-    resumed = run_pipeline(path, progress=False)
+    from shipblock.cli import main
+
+    assert main(["-q", "run", str(path)]) == 0  # resumed from the command line
     assert len(calls) == 2  # 36 runs in chunks of 9: the last two chunks only
+    with xr.open_dataset(tmp_path / "out" / "section.nc") as back:
+        resumed = back.load()
     # every number equal; of the attributes, only those naming the (other) folder differ
     xr.testing.assert_identical(full.drop_attrs(deep=False).drop_vars("history_file"),
                                 resumed.drop_attrs(deep=False).drop_vars("history_file"))
