@@ -25,6 +25,7 @@ ROOT = DOCS.parent
 sys.path.insert(0, str(ROOT))
 
 from docutils import nodes  # noqa: E402
+from docutils.parsers.rst import directives  # noqa: E402
 from docutils.statemachine import StringList  # noqa: E402
 from sphinx.directives.other import TocTree  # noqa: E402
 from sphinx.util import docname_join  # noqa: E402
@@ -154,15 +155,19 @@ class PipelineKeys(SphinxDirective):
 
     Written by :func:`shipblock.fragility.keys.key_table` from the keys' declarations (those of
     ``[system]``, ``[solver]`` and ``[sweep]`` from the model named, default ``rigid``), so the
-    page lists exactly what the parser accepts, with its type, unit, range and default.
+    page lists exactly what the parser accepts, with its type, unit, range and default. The
+    option ``:sections: system sweep solver`` lists only those sections (a model's keys).
     """
 
     optional_arguments = 1
+    option_spec = {"sections": directives.unchanged}
 
     def run(self):
         from shipblock.fragility.keys import key_table
 
-        text = key_table(self.arguments[0] if self.arguments else None)
+        sections = self.options.get("sections")
+        text = key_table(self.arguments[0] if self.arguments else None,
+                         sections.split() if sections else None)
         container = nodes.container()
         self.state.nested_parse(StringList(text.splitlines(), source="<pipeline-keys>"),
                                 self.content_offset, container)

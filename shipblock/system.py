@@ -456,3 +456,26 @@ def si_values(values) -> dict:
     return {key: (to_si(value, FIELD_UNITS[key], key)
                   if key in FIELD_UNITS and isinstance(value, str) else value)
             for key, value in values.items()}
+
+
+def system_line(system) -> str:
+    """One line naming a ship-block system as a report would: masses in t, block size in m,
+    friction static/kinetic per interface.
+
+    Parameters
+    ----------
+    system : Mapping
+        :meth:`ShipBlockSystem.to_dict`.
+
+    Returns
+    -------
+    str
+        e.g. ``"ship 5000 t on 150 blocks of 1.2 t, 2B x 2H = 0.6 x 1.2 m; friction
+        blocks-floor 0.6/0.55, ship-blocks 0.35/0.3 (static/kinetic)"``.
+    """
+    d = system
+    return (f"ship {float(d['ship_mass']) / 1e3:.4g} t on {int(d['n_blocks'])} blocks of "
+            f"{float(d['block_mass']) / 1e3:.3g} t, 2B x 2H = {2 * float(d['half_width']):.3g} x "
+            f"{2 * float(d['half_height']):.3g} m; friction blocks-floor "
+            f"{float(d['mu_s_ground']):.3g}/{float(d['mu_k_ground']):.3g}, ship-blocks "
+            f"{float(d['mu_s_ship']):.3g}/{float(d['mu_k_ship']):.3g} (static/kinetic)")

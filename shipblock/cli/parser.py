@@ -132,7 +132,9 @@ def build_parser():
     s.add_argument("--kind", choices=["fragility", "ida", "median"], default="fragility",
                    help="for batch results: fragility curves (default), IDA curves, or the "
                         "fitted median against a swept parameter")
-    s.add_argument("--edp", default="peak_ship_slip", help="demand parameter of the IDA curves")
+    s.add_argument("--edp", help="demand parameter of the IDA curves (default: the model's, "
+                                 "peak_ship_slip for the rigid model, keel_load_ratio for the "
+                                 "section model)")
     s.add_argument("--set", action="append", metavar="NAME=VALUE",
                    help="value of a swept parameter to draw, e.g. --set mu_ground=0.5 "
                         "(repeatable; default: the first value of each)")

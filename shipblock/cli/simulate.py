@@ -145,8 +145,11 @@ def _report(res, name, max_events):
 
 
 def _response_figure(res, record):
-    """The response figure, ``record`` the first line of its title (:func:`plot_response`;
-    None: a response dataset's own)."""
-    from shipblock.plot import plot_response
+    """The response figure, ``record`` the first line of its title (:func:`plot_response`, or
+    :func:`plot_section_response` for a run of the dock-section model; None: a response
+    dataset's own)."""
+    from shipblock.plot import is_section_response, plot_response, plot_section_response
 
+    if is_section_response(res) or hasattr(res, "result"):  # a SectionRun or its dataset
+        return plot_section_response(res, record=record)[0].figure
     return plot_response(res, record=record)[0].figure

@@ -39,13 +39,42 @@ def cmd_history(args):
         level = f" at {run_name(ds).rsplit(', ', 1)[-1]}"
     sys.stdout.write(f"run {ds.attrs['case']} of {args.pipeline}: {name}{level}, scale factor "
                      f"{ds.attrs['scale_factor']:.4g}\n")
-    _report(res, name, args.events)
+    if hasattr(res, "ground_acceleration"):  # the rigid model's SimulationResult
+        _report(res, name, args.events)
+    else:
+        _model_report(res, ds, args.events)
     record = dataset_record_line(ds)
     ds.attrs["record_description"] = record
     if args.output:
         _write_response(ds, args.output)
     _response_figure_option(res, record, args.figure, args.output)
     return 0
+
+
+def _model_report(res, ds, max_events):
+    """Print the outputs of a run of any model (with their units) and its events."""
+    from shipblock.fragility.store import dataset_model
+
+    model = dataset_model(ds)
+    out = sys.stdout
+    names = list(model.outputs) if model is not None else list(res.summary)
+    width = max(map(len, names))
+    for name in names:
+        value = res.summary.get(name)
+        units = model.outputs[name][0] if model is not None else ""
+        if isinstance(value, float) and model is not None and name == "failure":
+            value = f"{value:g} ({model.failure_codes.get(int(value), '?')})"
+        elif isinstance(value, float):
+            value = f"{value:.6g}"
+        out.write(f"{name:<{width}}  {value} {'' if units in ('', '1') else units}\n")
+    events = list(getattr(res, "events", []))
+    counts = {}
+    for e in events:
+        counts[e.kind] = counts.get(e.kind, 0) + 1
+    out.write("events: " + (", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+                            or "none") + "\n")
+    for e in events[:max_events]:
+        out.write(f"  t = {e.time:10.5f} s  {e.kind:<22} {getattr(e, 'where', '')}\n")
 
 
 def cmd_run(args):
@@ -81,7 +110,7 @@ def cmd_plot(args):
     with xr.open_dataset(args.results) as ds:
         ds = ds.load()
     figure = args.figure or str(Path(args.results).with_suffix(".png"))
-    if "x_b" in ds and "time" in ds.dims:
+    if ("x_b" in ds or "ship_sway" in ds) and "time" in ds.dims:
         _save_figure(lambda: _response_figure(ds, None), figure)  # the file's own record line
         sys.stdout.write(f"figure written to {figure}\n")
         return 0
@@ -89,6 +118,7 @@ def cmd_plot(args):
         raise UserError(f"{args.results}: neither a simulation response nor a fragility result")
     from shipblock.plot import (
         check_edp,
+        default_edp,
         plot_fragility,
         plot_ida,
         plot_median_sweep,
@@ -100,11 +130,12 @@ def cmd_plot(args):
     except ValueError as exc:
         raise UserError(f"{args.results}: --set {exc}") from None
     if args.kind == "ida":
+        edp = default_edp(ds) if args.edp is None else args.edp
         try:
-            check_edp(ds, args.edp, "--edp")
+            check_edp(ds, edp, "--edp")
         except ValueError as exc:
             raise UserError(f"{args.results}: {exc}") from None
-        _save_figure(lambda: plot_ida(ds, args.edp, sweep=sweep).figure, figure)
+        _save_figure(lambda: plot_ida(ds, edp, sweep=sweep).figure, figure)
     elif args.kind == "median":
         if not sweep:
             raise UserError(f"{args.results}: --kind median needs a study with a [sweep]")

@@ -88,7 +88,7 @@ def mark_solver_errors(out: dict, model: Model) -> np.ndarray:
     times = out.get("failure_time")
     for i in np.flatnonzero(bad):
         messages[i] = f"solver error (failure code {code})" + (
-            "" if times is None else f" at t = {times[i]:.6g} s")
+            "" if times is None or not np.isfinite(times[i]) else f" at t = {times[i]:.6g} s")
     for name in out:
         out[name] = np.where(bad, np.nan, out[name])
     return messages

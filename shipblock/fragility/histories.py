@@ -279,7 +279,7 @@ def case_dataset(result, design: AnalysisDesign, records, case: int,
     -------
     xarray.Dataset
         :meth:`~shipblock.SimulationResult.to_dataset` with global attributes ``case``,
-        ``record``, ``im_measure``, ``im_level`` and ``im_units`` (scaled designs),
+        ``model`` (its name), ``record``, ``im_measure``, ``im_level`` and ``im_units`` (scaled designs),
         ``scale_factor``,
         ``vertical_scale_factor``, ``swept_parameters`` (JSON) and ``record_provenance``
         (JSON).
@@ -291,6 +291,7 @@ def case_dataset(result, design: AnalysisDesign, records, case: int,
     ds.attrs.update({
         "title": f"shipblock time history: case {int(case)}, record {rec.id}",
         "case": int(case),
+        "model": design.model.name,
         "record": rec.id,
         "scale_factor": float(rec.factor_h[j]),
         "vertical_scale_factor": float(rec.factor_v[j]),

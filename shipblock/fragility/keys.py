@@ -316,7 +316,7 @@ def value(table: Mapping, section: str, key: str, source: str, model: Model | No
         raise PipelineError(exc.field, exc.problem, source) from None
 
 
-def key_table(model: Model | str | None = None) -> str:
+def key_table(model: Model | str | None = None, sections=None) -> str:
     """The table of every key, as reStructuredText (a ``list-table``).
 
     Parameters
@@ -324,6 +324,9 @@ def key_table(model: Model | str | None = None) -> str:
     model : shipblock.models.Model or str, optional
         Whose ``[system]``, ``[solver]`` and ``[sweep]`` keys to list (default: the rigid
         model).
+    sections : sequence of str, optional
+        Only these sections (e.g. ``("system", "sweep", "solver")``: a model's keys); default
+        all.
 
     Returns
     -------
@@ -337,7 +340,7 @@ def key_table(model: Model | str | None = None) -> str:
              "     - Default", "     - Description"]
     order = ["", "records", "system", "sweep", "design", "design.target_spectrum", "fit",
              "solver", "execution", "histories"]
-    for section in order:
+    for section in order if sections is None else [o for o in order if o in sections]:
         for name, field in section_fields(section, model).items():
             key = f"{section}.{name}" if section else name
             kind = " or ".join({int: "integer", float: "number", str: "string", list: "list",

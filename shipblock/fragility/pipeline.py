@@ -419,6 +419,7 @@ def _run_held(pipe, out_path: Path, client, scheduler, progress: bool, timings,
         "component": (f"azimuth {pipe.azimuth:g} deg" if pipe.azimuth is not None
                       else str(pipe.horizontal)),
         "catalogue": str(pipe.catalogue or "shipped records/catalogue.toml"),
+        "model": design.model.name,
         "system": json.dumps(design.model.describe(design.system), sort_keys=True),
         "sweep": json.dumps({k: list(v) for k, v in design.sweep}),
         "processing_chain": json.dumps(chain, sort_keys=True),

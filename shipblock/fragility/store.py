@@ -20,7 +20,8 @@ next run removes those of its own files (:func:`remove_stale_temporaries`,
 
 Every variable and coordinate of a result dataset carries ``units`` and ``long_name``;
 :attr:`Model.outputs <shipblock.models.base.Model.outputs>` lists those of the per-run summaries
-(:data:`RUN_VARIABLES` those of the rigid model).
+(:data:`RUN_VARIABLES` those of the rigid model); :func:`dataset_model` says which model wrote a
+result (its ``model`` attribute, or the ``[system]`` table of the pipeline it stores).
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ import os
 import re
 import secrets
 import shutil
+import tomllib
 import zipfile
 from pathlib import Path
 
@@ -41,6 +43,7 @@ import xarray as xr
 from shipblock import checks
 from shipblock.errors import ShipblockError
 from shipblock.fragility.filesystem import write_failure
+from shipblock.models import DEFAULT_MODEL, Model, get_model, model_names
 from shipblock.models.rigid import RUN_VARIABLES
 
 __all__ = [
@@ -49,6 +52,7 @@ __all__ = [
     "ChunkStore",
     "StoreError",
     "check_metadata",
+    "dataset_model",
     "open_results",
     "remove_stale_temporaries",
     "write_dataset",
@@ -327,6 +331,33 @@ class ChunkStore:
 # --------------------------------------------------------------------------------------------
 # final dataset
 # --------------------------------------------------------------------------------------------
+
+
+def dataset_model(ds) -> Model | None:
+    """The model that wrote a result or history dataset.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A result of :func:`shipblock.run_pipeline` or a run's histories.
+
+    Returns
+    -------
+    shipblock.models.Model or None
+        The model named by the attribute ``model``, else by ``[system] model`` of the stored
+        pipeline (a file of an earlier version), else the default (rigid) model; None if the
+        model named is not registered here.
+    """
+    name = ds.attrs.get("model")
+    if name is None:
+        try:
+            doc = tomllib.loads(str(ds.attrs.get("pipeline", "")))
+        except tomllib.TOMLDecodeError:
+            doc = {}
+        system = doc.get("system", {})
+        name = system.get("model", DEFAULT_MODEL) if isinstance(system, dict) else DEFAULT_MODEL
+    name = str(name)
+    return get_model(name) if name in model_names() else None
 
 
 def check_metadata(ds: xr.Dataset) -> None:

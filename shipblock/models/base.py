@@ -17,7 +17,9 @@ pipelines, the command line) never touches a model's equations. It talks to a :c
 * **a batch entry point** -- :meth:`Model.run_batch` runs many (input, system) cases in one
   call and returns one array per output, so that a model with a compiled batch kernel keeps
   its speed (the study makes one call per chunk of cases, never one per run);
-  :meth:`Model.simulate` runs one case with its full time histories (reruns, histories).
+  :meth:`Model.simulate` runs one case with its full time histories (reruns, histories);
+* **a caption** -- :meth:`Model.caption` names a system in one line for figures and reports,
+  and :meth:`Model.restore` rebuilds it from what a result file stores (:meth:`Model.describe`).
 
 Models are found by name (:func:`get_model`); a pipeline chooses one with
 ``[system] model = "<name>"`` (default ``"rigid"``, :class:`shipblock.models.rigid.RigidModel`).
@@ -286,6 +288,8 @@ class Model(ABC):
     solver_error_code : int or None
         A ``failure`` code meaning "the solver failed" (the run has no result: the batch
         stores NaN and a message), or None if the model has none.
+    default_edp : str or None
+        The EDP figures show when none is named (e.g. IDA curves); None: the first float EDP.
     """
 
     name: ClassVar[str]
@@ -297,6 +301,7 @@ class Model(ABC):
     outputs: ClassVar[Mapping[str, tuple[str, str]]]
     failure_codes: ClassVar[Mapping[int, str]] = {0: "none"}
     solver_error_code: ClassVar[int | None] = None
+    default_edp: ClassVar[str | None] = None
 
     @abstractmethod
     def build(self, values: Mapping[str, Any]):
@@ -333,6 +338,17 @@ class Model(ABC):
     @abstractmethod
     def describe(self, system) -> dict:
         """The system's parameters as a JSON-ready dict (stored with the results)."""
+
+    def restore(self, described: Mapping[str, Any]):
+        """The system again from :meth:`describe`'s output (e.g. a result file's ``system``
+        attribute); by default :meth:`build`."""
+        return self.build(described)
+
+    def caption(self, system) -> str:
+        """One line naming ``system`` for a figure's or report's title (by default its
+        :meth:`describe`, ``name = value`` pairs)."""
+        return ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                         for k, v in self.describe(system).items())
 
     def check_options(self, options: Mapping[str, Any]) -> dict:
         """The ``[solver]`` options with their defaults, each checked by its declaration.

@@ -54,6 +54,7 @@ from shipblock.system import (
     IMPACT_RULES,
     MIN_INERTIA_RATIO,
     ShipBlockSystem,
+    system_line,
     warn_implausible,
 )
 
@@ -280,6 +281,7 @@ class RigidModel(Model):
     outputs = MappingProxyType(RUN_VARIABLES)
     failure_codes = FAILURE_CODES
     solver_error_code = int(Failure.SOLVER_ERROR)
+    default_edp = "peak_ship_slip"
 
     def build(self, values: Mapping[str, Any]) -> ShipBlockSystem:
         """A :class:`~shipblock.ShipBlockSystem` from a ``[system]`` table (see the module).
@@ -330,6 +332,14 @@ class RigidModel(Model):
     def describe(self, system: ShipBlockSystem) -> dict:
         """:meth:`ShipBlockSystem.to_dict <shipblock.ShipBlockSystem.to_dict>`."""
         return system.to_dict()
+
+    def restore(self, described: Mapping[str, Any]) -> ShipBlockSystem:
+        """:class:`~shipblock.ShipBlockSystem` from its ``to_dict()``."""
+        return ShipBlockSystem(**described)
+
+    def caption(self, system: ShipBlockSystem) -> str:
+        """:func:`system_line`."""
+        return system_line(system.to_dict())
 
     def run_batch(self, systems: Sequence[ShipBlockSystem], inputs: Sequence[tuple],
                   dts: Sequence[float], cases: np.ndarray, **options) -> dict[str, np.ndarray]:

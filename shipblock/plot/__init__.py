@@ -12,6 +12,8 @@ whole record.
 
 * :mod:`shipblock.plot.response`: :func:`plot_response`, :func:`plot_record`,
   :func:`plot_spectrum`;
+* :mod:`shipblock.plot.section`: :func:`plot_section_response` (a run of the dock-section
+  model);
 * :mod:`shipblock.plot.study`: :func:`plot_fragility`, :func:`plot_ida`,
   :func:`plot_median_sweep`;
 * :mod:`shipblock.plot.record`: :func:`plot_record_overview` (``shipblock info --figure``).
@@ -43,9 +45,11 @@ from shipblock.plot.response import (
     plot_spectrum,
     run_name,
 )
+from shipblock.plot.section import is_section_response, plot_section_response
 # The study figures load on first use: shipblock.fragility imports the solver, which a command
 # that draws a response or a record must not import (nor compile).
-_STUDY = ("DODGE", "MARKER_SIZE", "MARKER_STEP", "check_edp", "limit_state_text", "marker_sizes",
+_STUDY = ("DODGE", "MARKER_SIZE", "MARKER_STEP", "check_edp", "default_edp", "limit_state_text",
+          "marker_sizes",
           "plot_fragility", "plot_ida", "plot_median_sweep", "study_caption", "sweep_selection",
           "sweep_text")
 
@@ -76,6 +80,8 @@ __all__ = [
     "active_window",
     "check_edp",
     "dataset_record_line",
+    "default_edp",
+    "is_section_response",
     "limit_state_text",
     "marker_sizes",
     "mode_spans",
@@ -85,6 +91,7 @@ __all__ = [
     "plot_record",
     "plot_record_overview",
     "plot_response",
+    "plot_section_response",
     "plot_spectrum",
     "record_line",
     "record_text",

@@ -8,6 +8,9 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from shipblock.system import system_line
+
+
 def _pyplot():
     import matplotlib.pyplot as plt
 
@@ -45,8 +48,9 @@ def wrapped(lines, width) -> str:
 
 
 def system_text(system) -> str:
-    """One line naming a ship-block system as a report would: masses in t, block size in m,
-    friction static/kinetic per interface.
+    """One line naming a ship-block system of the rigid model as a report would
+    (:func:`shipblock.system.system_line`): masses in t, block size in m, friction
+    static/kinetic per interface.
 
     Parameters
     ----------
@@ -59,12 +63,7 @@ def system_text(system) -> str:
         e.g. ``"ship 5000 t on 150 blocks of 1.2 t, 2B x 2H = 0.6 x 1.2 m; friction
         blocks-floor 0.6/0.55, ship-blocks 0.35/0.3 (static/kinetic)"``.
     """
-    d = system if isinstance(system, Mapping) else system.to_dict()
-    return (f"ship {float(d['ship_mass']) / 1e3:.4g} t on {int(d['n_blocks'])} blocks of "
-            f"{float(d['block_mass']) / 1e3:.3g} t, 2B x 2H = {2 * float(d['half_width']):.3g} x "
-            f"{2 * float(d['half_height']):.3g} m; friction blocks-floor "
-            f"{float(d['mu_s_ground']):.3g}/{float(d['mu_k_ground']):.3g}, ship-blocks "
-            f"{float(d['mu_s_ship']):.3g}/{float(d['mu_k_ship']):.3g} (static/kinetic)")
+    return system_line(system if isinstance(system, Mapping) else system.to_dict())
 
 
 def record_text(motion, scale=None) -> str:

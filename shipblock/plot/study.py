@@ -11,11 +11,10 @@ from pathlib import PurePath
 import numpy as np
 
 from shipblock.errors import ParameterError
-from shipblock.fragility.design import apply_parameters
-from shipblock.fragility.limit_states import EDP_VARIABLES
 from shipblock.fragility.report import display_units, im_label
-from shipblock.plot._common import _new_axes, _title, system_text
-from shipblock.system import ShipBlockSystem
+from shipblock.fragility.store import dataset_model
+from shipblock.models import DEFAULT_MODEL, get_model
+from shipblock.plot._common import _new_axes, _title
 
 _DESIGN_NAMES = {"ida": "IDA", "msa": "MSA", "cloud": "cloud"}
 _VERTICAL_TEXT = {"same": "vertical scaled with the horizontal",
@@ -28,7 +27,9 @@ def study_caption(ds, sweep=None) -> list[str]:
 
     The study is the pipeline's ``title`` and file (attributes ``title`` and
     ``pipeline_source``); the system is the pipeline's, with the swept values drawn
-    (``sweep``) applied (:func:`shipblock.fragility.design.apply_parameters`); the design names
+    (``sweep``) applied (:meth:`Model.vary <shipblock.models.base.Model.vary>` of the model that
+    wrote it, :func:`~shipblock.fragility.store.dataset_model`, named by its
+    :meth:`~shipblock.models.base.Model.caption`); the design names
     the analysis (IDA, MSA or cloud), the measure, the records and levels run, and the
     vertical.
 
@@ -52,11 +53,12 @@ def study_caption(ds, sweep=None) -> list[str]:
         source = PurePath(source).name
     if title or source:
         lines.append(title + (f" ({source})" if source and title else source))
-    if "system" in ds.attrs:
-        system = json.loads(ds.attrs["system"])
+    model = dataset_model(ds)
+    if "system" in ds.attrs and model is not None:
+        system = model.restore(json.loads(ds.attrs["system"]))
         if sweep:
-            system = apply_parameters(ShipBlockSystem(**system), dict(sweep)).to_dict()
-        lines.append("system: " + system_text(system))
+            system = model.vary(system, {k: _plain(v) for k, v in dict(sweep).items()})
+        lines.append("system: " + model.caption(system))
     kind = str(ds.attrs.get("design_type", ""))
     if kind:
         measure = im_label(ds).rsplit(" [", 1)[0]
@@ -73,6 +75,11 @@ def study_caption(ds, sweep=None) -> list[str]:
             text += f"; {vertical}"
         lines.append(text)
     return lines
+
+
+def _plain(value):
+    """A numpy scalar of a coordinate as a Python number (a model's checks want those)."""
+    return value.item() if isinstance(value, np.generic) else value
 
 
 def _im_axis(ds, values):
@@ -394,15 +401,39 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
     return ax
 
 
+def numeric_edps(ds) -> list[str]:
+    """The float and count EDPs of the results' model that the results hold."""
+    model = dataset_model(ds) or get_model(DEFAULT_MODEL)
+    return [k for k, info in model.edps.items() if k in ds and info.kind in ("float", "count")]
+
+
+def default_edp(ds) -> str:
+    """The EDP a figure of the results shows when none is named: the model's
+    :attr:`~shipblock.models.base.Model.default_edp` if the results hold it, else the first
+    numeric one."""
+    model = dataset_model(ds) or get_model(DEFAULT_MODEL)
+    valid = numeric_edps(ds)
+    if model.default_edp in valid or not valid:
+        return model.default_edp or ""
+    return valid[0]
+
+
+def failures_text(ds) -> str:
+    """``"separation, overturning"``: the failure kinds of the results' model."""
+    model = dataset_model(ds) or get_model(DEFAULT_MODEL)
+    return ", ".join(what for code, what in model.failure_codes.items()
+                     if code and code != model.solver_error_code)
+
+
 def check_edp(ds, edp, name="edp") -> str:
     """``edp`` if the results hold it as a numeric demand parameter, else a ParameterError
     naming ``name`` (a keyword or a flag), the closest valid name and all of them.
 
-    The valid names are those of :data:`shipblock.fragility.limit_states.EDP_VARIABLES` of kind
+    The valid names are the EDPs of the results' model
+    (:attr:`Model.edps <shipblock.models.base.Model.edps>`, :func:`dataset_model`) of kind
     float or count that the results hold.
     """
-    valid = [k for k, info in EDP_VARIABLES.items()
-             if k in ds and info.kind in ("float", "count")]
+    valid = numeric_edps(ds)
     if edp in valid:
         return edp
     close = difflib.get_close_matches(str(edp), valid, n=1)
@@ -411,7 +442,7 @@ def check_edp(ds, edp, name="edp") -> str:
                          + f"; valid: {', '.join(valid)}")
 
 
-def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
+def plot_ida(ds, edp=None, ax=None, sweep=None):
     """IDA curves: the demand ``edp`` of each record against the intensity it was scaled to.
 
     Runs that failed (separation, overturning) are marked with a cross at the right edge. The
@@ -421,8 +452,10 @@ def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
     ----------
     ds : xarray.Dataset
         Result of :func:`shipblock.run_pipeline` of an IDA or MSA study.
-    edp : str
-        The demand on the x axis (a ParameterError lists the valid names: :func:`check_edp`).
+    edp : str, optional
+        The demand on the x axis (a ParameterError lists the valid names: :func:`check_edp`);
+        default: the model's :attr:`~shipblock.models.base.Model.default_edp`
+        (``peak_ship_slip`` for the rigid model, ``keel_load_ratio`` for the section model).
     ax : matplotlib Axes, optional
     sweep : dict, optional
         Value of each swept parameter to draw (default: the first of each); named in the title.
@@ -431,6 +464,7 @@ def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
     -------
     matplotlib.axes.Axes
     """
+    edp = default_edp(ds) if edp is None else edp
     check_edp(ds, edp)
     if ax is None:
         _, axs = _new_axes(1, height=4.0)
@@ -455,7 +489,7 @@ def plot_ida(ds, edp="peak_ship_slip", ax=None, sweep=None):
     ax.set_ylabel(ylabel)
     ax.grid(True, lw=0.3, alpha=0.5)
     what = (f"IDA curves: {ds[edp].attrs.get('long_name', edp)} of each record against the "
-            f"intensity it was scaled to; x: failure (separation, overturning), drawn at the "
+            f"intensity it was scaled to; x: a failed run ({failures_text(ds)}), drawn at the "
             f"right edge")
     if sweep:
         what += f"; drawn at {sweep_text(sweep)}"

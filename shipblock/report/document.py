@@ -40,9 +40,10 @@ import xarray as xr
 from shipblock import __version__
 from shipblock.errors import ParameterError
 from shipblock.fragility.report import display_units, im_label, study_report
-from shipblock.models import DEFAULT_MODEL, get_model, model_names
+from shipblock.fragility.store import dataset_model
 from shipblock.plot import (
     TITLE_WIDTH,
+    default_edp,
     limit_state_text,
     plot_fragility,
     plot_ida,
@@ -51,6 +52,7 @@ from shipblock.plot import (
     sweep_selection,
     sweep_text,
 )
+from shipblock.plot.study import failures_text
 from shipblock.plot_risk import plot_risk
 from shipblock.risk.study import risk_lines
 from shipblock.scaling import TargetSpectrum, spectrum_match
@@ -173,8 +175,7 @@ def _pipeline_document(ds) -> dict:
 
 
 def _model(ds):
-    name = str(_pipeline_document(ds).get("system", {}).get("model", DEFAULT_MODEL))
-    return get_model(name) if name in model_names() else None
+    return dataset_model(ds)
 
 
 # ------------------------------------------------------------------------------ sections
@@ -453,7 +454,7 @@ def _limit_states_section(ds) -> list:
         rows.append((name, limit_state_text(ds, name), long_name, d.get("description", "")))
     return [Heading("3. Limit states"),
             _p("A run exceeds a limit state when its demand meets the condition; a run that "
-               "failed (separation, overturning) exceeds every response limit state."),
+               f"failed ({failures_text(ds)}) exceeds every response limit state."),
             _t(["limit state", "definition", "demand parameter", "description"], rows)]
 
 
@@ -508,7 +509,7 @@ def _fragility_section(ds) -> list:
     for dim in sweep:
         out.append(Figure(lambda dim=dim: plot_median_sweep(ds, dim, sweep=sweep).figure,
                           f"median against {dim}"))
-    if "im_level" in ds.coords and "peak_ship_slip" in ds:
+    if "im_level" in ds.coords and default_edp(ds) in ds:
         out.append(Figure(lambda: plot_ida(ds, sweep=sweep).figure, "IDA curves"))
     return out
 

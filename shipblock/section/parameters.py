@@ -82,11 +82,12 @@ def _check(obj, limits: dict) -> None:
         if value is None and optional:
             continue
         real(value, f"{prefix}.{name}", low=low, high=high, units=units, low_open=low == 0.0
-             and name not in _ZERO_ALLOWED)
+             and name not in ZERO_ALLOWED)
 
 
-_ZERO_ALLOWED = {"g_offset", "offset", "hull_height", "hull_slope", "mu_s", "mu_k",
-                 "damping_ratio", "force", "pressure", "area"}
+#: Fields whose range starts at 0 included (the others with a lower bound of 0 exclude it).
+ZERO_ALLOWED = {"g_offset", "offset", "hull_height", "hull_slope", "mu_s", "mu_k",
+                "damping_ratio", "force", "pressure", "area"}
 
 
 @dataclass(frozen=True)
