@@ -146,14 +146,38 @@ def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, d
             tang[j] = -fs[j] * strip_f[j, SF_MUK] * total
 
 
+@njit(cache=True, inline="always")
+def _trig(body, angle):
+    """cos and sin of a pose's angle; the floor's zero angle without a call (the same values)."""
+    if body < 0 and angle == 0.0:
+        return 1.0, 0.0
+    return math.cos(angle), math.sin(angle)
+
+
+@njit(cache=True, inline="always")
+def _apply(xdot, o_v, cb, sb, cy, cz, sy, sz, py, pz, fy_, fz_):
+    """Add the force ``(fy_, fz_)`` at ``(py, pz)`` to C's momentum rates, and its opposite to S's."""
+    if cb >= 0:
+        xdot[o_v + 3 * cb] += fy_
+        xdot[o_v + 3 * cb + 1] += fz_
+        xdot[o_v + 3 * cb + 2] += (py - cy) * fz_ - (pz - cz) * fy_
+    if sb >= 0:
+        xdot[o_v + 3 * sb] -= fy_
+        xdot[o_v + 3 * sb + 1] -= fz_
+        xdot[o_v + 3 * sb + 2] -= (py - sy) * fz_ - (pz - sz) * fy_
+
+
 @njit(cache=True)
 def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
         dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, xdot):
-    """Time derivative of the state (Newton-Euler of every body, contact laws, energy rates)."""
-    kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
+    """Time derivative of the state (Newton-Euler of every body, contact laws, energy rates).
+
+    One pass per strip does what :func:`kinematics` and :func:`contact_forces` do (the same
+    arithmetic, filling the same work arrays) and applies the forces, with each pose's cos and sin
+    evaluated once: the hot loop of the integrator (about 6 calls per step).
+    """
+    o_v = 3 * nb
     o_u = 6 * nb
-    contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
-                   delta_dot, vt, fe, fn, normal, tang)
     # ground acceleration, linear between samples
     s = t / dt_rec
     k = int(s)
@@ -165,77 +189,100 @@ def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, op
         az = ag_z[k] + w * (ag_z[k + 1] - ag_z[k])
     g = opt[O_G]
     for b in range(nb):
-        xdot[3 * b] = x[3 * nb + 3 * b]
-        xdot[3 * b + 1] = x[3 * nb + 3 * b + 1]
-        xdot[3 * b + 2] = x[3 * nb + 3 * b + 2]
-        xdot[3 * nb + 3 * b] = -mass[b] * ay
-        xdot[3 * nb + 3 * b + 1] = -mass[b] * (g + az)
-        xdot[3 * nb + 3 * b + 2] = 0.0
+        xdot[3 * b] = x[o_v + 3 * b]
+        xdot[3 * b + 1] = x[o_v + 3 * b + 1]
+        xdot[3 * b + 2] = x[o_v + 3 * b + 2]
+        xdot[o_v + 3 * b] = -mass[b] * ay
+        xdot[o_v + 3 * b + 1] = -mass[b] * (g + az)
+        xdot[o_v + 3 * b + 2] = 0.0
     d_damp = 0.0
     d_fric = 0.0
     for j in range(ns):
         cb, sb = strip_i[j, SI_C], strip_i[j, SI_S]
         cy, cz, ca = _pose(x, cb, strip_f[j, SF_PY], strip_f[j, SF_PZ], strip_f[j, SF_PA])
         sy, sz, sa = _pose(x, sb, 0.0, 0.0, 0.0)
-        sc, ss = math.cos(sa), math.sin(sa)
+        cvy, cvz, cw = _vel(x, nb, cb)
+        svy, svz, sw = _vel(x, nb, sb)
+        cc, cs = _trig(cb, ca)
+        sc, ss = _trig(sb, sa)
         ny = sc * strip_f[j, SF_SNY] - ss * strip_f[j, SF_SNZ]
         nz = ss * strip_f[j, SF_SNY] + sc * strip_f[j, SF_SNZ]
+        qy = sy + sc * strip_f[j, SF_SQY] - ss * strip_f[j, SF_SQZ]
+        qz = sz + ss * strip_f[j, SF_SQY] + sc * strip_f[j, SF_SQZ]
         first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
+        total = 0.0
         for i in range(first, first + count):
-            f = fn[i]
-            if reg[i] != R_FREE:
-                d_damp += spring_f[i, PF_C] * delta_dot[i] * delta_dot[i]
-            if f == 0.0:
-                continue
-            py, pz = pos[i, 0], pos[i, 1]
-            fy_, fz_ = f * ny, f * nz
-            if cb >= 0:
-                xdot[3 * nb + 3 * cb] += fy_
-                xdot[3 * nb + 3 * cb + 1] += fz_
-                xdot[3 * nb + 3 * cb + 2] += (py - cy) * fz_ - (pz - cz) * fy_
-            if sb >= 0:
-                xdot[3 * nb + 3 * sb] -= fy_
-                xdot[3 * nb + 3 * sb + 1] -= fz_
-                xdot[3 * nb + 3 * sb + 2] -= (py - sy) * fz_ - (pz - sz) * fy_
-        ft = tang[j]
-        xdot[o_u + j] = vt[j] if fs[j] == F_STICK else 0.0
-        if fs[j] == F_STICK:
-            d_damp += strip_f[j, SF_CT] * vt[j] * vt[j]
-        elif fs[j] != F_FREE:
-            d_fric += -ft * vt[j]
-        if ft != 0.0:
-            cc, cs = math.cos(ca), math.sin(ca)
-            ry, rz = strip_f[j, SF_CY], strip_f[j, SF_CZ]
+            ry, rz = spring_f[i, PF_RY], spring_f[i, PF_RZ]
             py = cy + cc * ry - cs * rz
             pz = cz + cs * ry + cc * rz
-            fy_, fz_ = ft * nz, -ft * ny  # along t = (n_z, -n_y)
-            if cb >= 0:
-                xdot[3 * nb + 3 * cb] += fy_
-                xdot[3 * nb + 3 * cb + 1] += fz_
-                xdot[3 * nb + 3 * cb + 2] += (py - cy) * fz_ - (pz - cz) * fy_
-            if sb >= 0:
-                xdot[3 * nb + 3 * sb] -= fy_
-                xdot[3 * nb + 3 * sb + 1] -= fz_
-                xdot[3 * nb + 3 * sb + 2] -= (py - sy) * fz_ - (pz - sz) * fy_
+            pos[i, 0] = py
+            pos[i, 1] = pz
+            di = (qy - py) * ny + (qz - pz) * nz
+            delta[i] = di
+            vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
+            vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
+            ddi = (vsy - vcy) * ny + (vsz - vcz) * nz
+            delta_dot[i] = ddi
+            c = spring_f[i, PF_C]
+            ri = reg[i]
+            if ri == R_ELASTIC:
+                fei = spring_f[i, PF_K] * (di - dp[i])
+                f = fei + c * ddi
+            elif ri == R_CRUSH:
+                fei = spring_f[i, PF_FY]
+                f = fei + c * ddi
+            else:
+                fei = 0.0
+                f = 0.0
+            fe[i] = fei
+            fn[i] = f
+            total += f
+            if ri != R_FREE:
+                d_damp += c * ddi * ddi
+            if f != 0.0:
+                _apply(xdot, o_v, cb, sb, cy, cz, sy, sz, py, pz, f * ny, f * nz)
+        normal[j] = total
+        ry, rz = strip_f[j, SF_CY], strip_f[j, SF_CZ]
+        py = cy + cc * ry - cs * rz
+        pz = cz + cs * ry + cc * rz
+        vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
+        vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
+        # tangent t = (n_z, -n_y): (1, 0) on the floor
+        vtj = (vcy - vsy) * nz - (vcz - vsz) * ny
+        vt[j] = vtj
+        if fs[j] == F_STICK:
+            ft = -strip_f[j, SF_KT] * x[o_u + j] - strip_f[j, SF_CT] * vtj
+            xdot[o_u + j] = vtj
+            d_damp += strip_f[j, SF_CT] * vtj * vtj
+        elif fs[j] == F_FREE:
+            ft = 0.0
+            xdot[o_u + j] = 0.0
+        else:
+            ft = -fs[j] * strip_f[j, SF_MUK] * total
+            xdot[o_u + j] = 0.0
+            d_fric += -ft * vtj
+        tang[j] = ft
+        if ft != 0.0:
+            _apply(xdot, o_v, cb, sb, cy, cz, sy, sz, py, pz, ft * nz, -ft * ny)
     # wind on the ship at its point (O_WIND_Y, O_WIND_Z) in the ship's frame
     fw = opt[O_WIND_F]
     w_wind = 0.0
     if fw != 0.0:
         ca, sa = math.cos(x[2]), math.sin(x[2])
         rz = sa * opt[O_WIND_Y] + ca * opt[O_WIND_Z]
-        xdot[3 * nb] += fw
-        xdot[3 * nb + 2] += -rz * fw
-        w_wind = fw * (x[3 * nb] - x[3 * nb + 2] * rz)
+        xdot[o_v] += fw
+        xdot[o_v + 2] += -rz * fw
+        w_wind = fw * (x[o_v] - x[o_v + 2] * rz)
     w_ground = 0.0
     for b in range(nb):
-        o = 3 * nb + 3 * b
+        o = o_v + 3 * b
         w_ground -= mass[b] * (ay * x[o] + az * x[o + 1])
         xdot[o] /= mass[b]
         xdot[o + 1] /= mass[b]
         xdot[o + 2] /= inertia[b]
     if opt[O_ROLL_HELD] != 0.0:
         xdot[2] = 0.0
-        xdot[3 * nb + 2] = 0.0
+        xdot[o_v + 2] = 0.0
     o_e = o_u + ns
     xdot[o_e] = w_ground
     xdot[o_e + 1] = w_wind
@@ -248,9 +295,17 @@ def event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs
                  delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, gv):
     """Event functions of the current regimes: an event happens when one goes from > 0 to <= 0."""
     kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
-    o_u = 6 * nb
-    contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
+    contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
                    delta_dot, vt, fe, fn, normal, tang)
+    _event_values_of(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
+                     delta, delta_dot, vt, fe, fn, normal, tang, theta_c, gv)
+
+
+@njit(cache=True)
+def _event_values_of(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
+                     delta, delta_dot, vt, fe, fn, normal, tang, theta_c, gv):
+    """:func:`event_values` from the kinematics and contact forces of ``x`` already in the work
+    arrays (after :func:`rhs` at the same state and regimes)."""
     nsp = spring_f.shape[0]
     min_gap = BIG
     for j in range(ns):
@@ -451,8 +506,9 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             r[3, m] = d - h * k7[m] - r[2, m]
             r[4, m] = h * (_D1 * k1[m] + _D3 * k3[m] + _D4 * k4[m] + _D5 * k5[m] + _D6 * k6[m]
                            + _D7 * k7[m])
-        event_values(t + h, x1, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
-                     delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g1)
+        # the work arrays hold x1's kinematics and forces from the evaluation of k7
+        _event_values_of(t + h, x1, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs,
+                         opt, delta, delta_dot, vt, fe, fn, normal, tang, theta_c, g1)
         # the earliest event in the step, located by bisection on the dense output
         first = -1
         lo, hi = 0.0, 1.0
