@@ -72,42 +72,67 @@ def _vel(x, nb, body):
 
 
 @njit(cache=True, inline="always")
+def _trig(body, angle):
+    """cos and sin of a pose's angle; the floor's zero angle without a call (the same values)."""
+    if body < 0 and angle == 0.0:
+        return 1.0, 0.0
+    return math.cos(angle), math.sin(angle)
+
+
+@njit(cache=True, inline="always")
+def _frame(x, nb, j, strip_f, strip_i):
+    """What every spring of strip j needs, so that a spring costs a few products.
+
+    With C's pose ``(c, R_C)``, S's ``(s, R_S)``, a spring at ``rho = R_C r`` from c (``r`` its
+    point in C's frame), S's surface point ``q`` and normal ``n``, and ``w = omega_S - omega_C``:
+    closure ``delta = D0 - r . a`` with ``a = R_C^T n``; the moment arm ``m = rho x n = r x a``;
+    closure rate ``delta_dot = E0 + w m``; the force ``f n`` at the spring has the moment
+    ``f m`` about c and ``-f (L0 + m)`` about s. Returns ``(cb, sb, ny, nz, a1, a2, D0, E0, w, L0,
+    cy, cz, cc, cs, T0, P0)``; ``T0`` and ``P0`` give the tangential slip rate and the moment
+    about s of a tangential force at a point of C (see :func:`rhs`).
+    """
+    cb, sb = strip_i[j, SI_C], strip_i[j, SI_S]
+    cy, cz, ca = _pose(x, cb, strip_f[j, SF_PY], strip_f[j, SF_PZ], strip_f[j, SF_PA])
+    sy, sz, sa = _pose(x, sb, 0.0, 0.0, 0.0)
+    cvy, cvz, cw = _vel(x, nb, cb)
+    svy, svz, sw = _vel(x, nb, sb)
+    cc, cs = _trig(cb, ca)
+    sc, ss = _trig(sb, sa)
+    ny = sc * strip_f[j, SF_SNY] - ss * strip_f[j, SF_SNZ]
+    nz = ss * strip_f[j, SF_SNY] + sc * strip_f[j, SF_SNZ]
+    qy = sy + sc * strip_f[j, SF_SQY] - ss * strip_f[j, SF_SQZ]
+    qz = sz + ss * strip_f[j, SF_SQY] + sc * strip_f[j, SF_SQZ]
+    a1 = cc * ny + cs * nz
+    a2 = cc * nz - cs * ny
+    dy, dz = cy - sy, cz - sz
+    d0 = (qy - cy) * ny + (qz - cz) * nz
+    # relative velocity of S's and C's points at c
+    ry_ = svy - cvy - sw * dz
+    rz_ = svz - cvz + sw * dy
+    e0 = ry_ * ny + rz_ * nz
+    t0 = ry_ * nz - rz_ * ny
+    return (cb, sb, ny, nz, a1, a2, d0, e0, sw - cw, dy * nz - dz * ny, cy, cz, cc, cs, t0,
+            dy * ny + dz * nz)
+
+
+@njit(cache=True, inline="always")
 def kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
     """Closure and closure rate of every spring, tangential slip rate of every strip.
 
     ``pos[i] = (py, pz)`` is the world position of spring i's point on C (where its force acts).
     """
     for j in range(strip_i.shape[0]):
-        cb, sb = strip_i[j, SI_C], strip_i[j, SI_S]
-        cy, cz, ca = _pose(x, cb, strip_f[j, SF_PY], strip_f[j, SF_PZ], strip_f[j, SF_PA])
-        sy, sz, sa = _pose(x, sb, 0.0, 0.0, 0.0)
-        cvy, cvz, cw = _vel(x, nb, cb)
-        svy, svz, sw = _vel(x, nb, sb)
-        cc, cs = math.cos(ca), math.sin(ca)
-        sc, ss = math.cos(sa), math.sin(sa)
-        ny = sc * strip_f[j, SF_SNY] - ss * strip_f[j, SF_SNZ]
-        nz = ss * strip_f[j, SF_SNY] + sc * strip_f[j, SF_SNZ]
-        qy = sy + sc * strip_f[j, SF_SQY] - ss * strip_f[j, SF_SQZ]
-        qz = sz + ss * strip_f[j, SF_SQY] + sc * strip_f[j, SF_SQZ]
+        (cb, sb, ny, nz, a1, a2, d0, e0, w, l0, cy, cz, cc, cs, t0,
+         p0) = _frame(x, nb, j, strip_f, strip_i)
         first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
         for i in range(first, first + count):
             ry, rz = spring_f[i, PF_RY], spring_f[i, PF_RZ]
-            py = cy + cc * ry - cs * rz
-            pz = cz + cs * ry + cc * rz
-            pos[i, 0] = py
-            pos[i, 1] = pz
-            delta[i] = (qy - py) * ny + (qz - pz) * nz
-            # velocities of the body-fixed points of S and C at p
-            vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
-            vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
-            delta_dot[i] = (vsy - vcy) * ny + (vsz - vcz) * nz
-        ry, rz = strip_f[j, SF_CY], strip_f[j, SF_CZ]
-        py = cy + cc * ry - cs * rz
-        pz = cz + cs * ry + cc * rz
-        vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
-        vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
-        # tangent t = (n_z, -n_y): (1, 0) on the floor
-        vt[j] = (vcy - vsy) * nz - (vcz - vsz) * ny
+            pos[i, 0] = cy + cc * ry - cs * rz
+            pos[i, 1] = cz + cs * ry + cc * rz
+            delta[i] = d0 - (ry * a1 + rz * a2)
+            delta_dot[i] = e0 + w * (ry * a2 - rz * a1)
+        # tangent t = (n_z, -n_y): (1, 0) on the floor; C's face centre slips at w (r . a) - T0
+        vt[j] = w * (strip_f[j, SF_CY] * a1 + strip_f[j, SF_CZ] * a2) - t0
 
 
 @njit(cache=True, inline="always")
@@ -146,35 +171,14 @@ def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, d
             tang[j] = -fs[j] * strip_f[j, SF_MUK] * total
 
 
-@njit(cache=True, inline="always")
-def _trig(body, angle):
-    """cos and sin of a pose's angle; the floor's zero angle without a call (the same values)."""
-    if body < 0 and angle == 0.0:
-        return 1.0, 0.0
-    return math.cos(angle), math.sin(angle)
-
-
-@njit(cache=True, inline="always")
-def _apply(xdot, o_v, cb, sb, cy, cz, sy, sz, py, pz, fy_, fz_):
-    """Add the force ``(fy_, fz_)`` at ``(py, pz)`` to C's momentum rates, and its opposite to S's."""
-    if cb >= 0:
-        xdot[o_v + 3 * cb] += fy_
-        xdot[o_v + 3 * cb + 1] += fz_
-        xdot[o_v + 3 * cb + 2] += (py - cy) * fz_ - (pz - cz) * fy_
-    if sb >= 0:
-        xdot[o_v + 3 * sb] -= fy_
-        xdot[o_v + 3 * sb + 1] -= fz_
-        xdot[o_v + 3 * sb + 2] -= (py - sy) * fz_ - (pz - sz) * fy_
-
-
 @njit(cache=True)
 def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
         dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, xdot):
     """Time derivative of the state (Newton-Euler of every body, contact laws, energy rates).
 
     One pass per strip does what :func:`kinematics` and :func:`contact_forces` do (the same
-    arithmetic, filling the same work arrays) and applies the forces, with each pose's cos and sin
-    evaluated once: the hot loop of the integrator (about 6 calls per step).
+    formulas, :func:`_frame`, filling the same work arrays) and applies the strip's resultant
+    force and moment to C and S once: the hot loop of the integrator (6 calls per step).
     """
     o_v = 3 * nb
     o_u = 6 * nb
@@ -198,57 +202,39 @@ def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, op
     d_damp = 0.0
     d_fric = 0.0
     for j in range(ns):
-        cb, sb = strip_i[j, SI_C], strip_i[j, SI_S]
-        cy, cz, ca = _pose(x, cb, strip_f[j, SF_PY], strip_f[j, SF_PZ], strip_f[j, SF_PA])
-        sy, sz, sa = _pose(x, sb, 0.0, 0.0, 0.0)
-        cvy, cvz, cw = _vel(x, nb, cb)
-        svy, svz, sw = _vel(x, nb, sb)
-        cc, cs = _trig(cb, ca)
-        sc, ss = _trig(sb, sa)
-        ny = sc * strip_f[j, SF_SNY] - ss * strip_f[j, SF_SNZ]
-        nz = ss * strip_f[j, SF_SNY] + sc * strip_f[j, SF_SNZ]
-        qy = sy + sc * strip_f[j, SF_SQY] - ss * strip_f[j, SF_SQZ]
-        qz = sz + ss * strip_f[j, SF_SQY] + sc * strip_f[j, SF_SQZ]
+        (cb, sb, ny, nz, a1, a2, d0, e0, w, l0, cy, cz, cc, cs, t0,
+         p0) = _frame(x, nb, j, strip_f, strip_i)
         first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
         total = 0.0
+        moment = 0.0  # sum of f m: the springs' moment about c
         for i in range(first, first + count):
             ry, rz = spring_f[i, PF_RY], spring_f[i, PF_RZ]
-            py = cy + cc * ry - cs * rz
-            pz = cz + cs * ry + cc * rz
-            pos[i, 0] = py
-            pos[i, 1] = pz
-            di = (qy - py) * ny + (qz - pz) * nz
+            m = ry * a2 - rz * a1
+            di = d0 - (ry * a1 + rz * a2)
+            ddi = e0 + w * m
             delta[i] = di
-            vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
-            vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
-            ddi = (vsy - vcy) * ny + (vsz - vcz) * nz
             delta_dot[i] = ddi
             c = spring_f[i, PF_C]
             ri = reg[i]
             if ri == R_ELASTIC:
                 fei = spring_f[i, PF_K] * (di - dp[i])
                 f = fei + c * ddi
+                d_damp += c * ddi * ddi
             elif ri == R_CRUSH:
                 fei = spring_f[i, PF_FY]
                 f = fei + c * ddi
+                d_damp += c * ddi * ddi
             else:
                 fei = 0.0
                 f = 0.0
             fe[i] = fei
             fn[i] = f
             total += f
-            if ri != R_FREE:
-                d_damp += c * ddi * ddi
-            if f != 0.0:
-                _apply(xdot, o_v, cb, sb, cy, cz, sy, sz, py, pz, f * ny, f * nz)
+            moment += f * m
         normal[j] = total
-        ry, rz = strip_f[j, SF_CY], strip_f[j, SF_CZ]
-        py = cy + cc * ry - cs * rz
-        pz = cz + cs * ry + cc * rz
-        vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
-        vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
-        # tangent t = (n_z, -n_y): (1, 0) on the floor
-        vtj = (vcy - vsy) * nz - (vcz - vsz) * ny
+        # C's face centre: tangential slip rate, stick spring or kinetic friction
+        dc = strip_f[j, SF_CY] * a1 + strip_f[j, SF_CZ] * a2
+        vtj = w * dc - t0
         vt[j] = vtj
         if fs[j] == F_STICK:
             ft = -strip_f[j, SF_KT] * x[o_u + j] - strip_f[j, SF_CT] * vtj
@@ -262,8 +248,17 @@ def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, op
             xdot[o_u + j] = 0.0
             d_fric += -ft * vtj
         tang[j] = ft
-        if ft != 0.0:
-            _apply(xdot, o_v, cb, sb, cy, cz, sy, sz, py, pz, ft * nz, -ft * ny)
+        # normal force total n and tangential ft t (t = (n_z, -n_y)) on C, the opposite on S
+        fy_ = total * ny + ft * nz
+        fz_ = total * nz - ft * ny
+        if cb >= 0:
+            xdot[o_v + 3 * cb] += fy_
+            xdot[o_v + 3 * cb + 1] += fz_
+            xdot[o_v + 3 * cb + 2] += moment - ft * dc
+        if sb >= 0:
+            xdot[o_v + 3 * sb] -= fy_
+            xdot[o_v + 3 * sb + 1] -= fz_
+            xdot[o_v + 3 * sb + 2] += ft * (p0 + dc) - total * l0 - moment
     # wind on the ship at its point (O_WIND_Y, O_WIND_Z) in the ship's frame
     fw = opt[O_WIND_F]
     w_wind = 0.0
