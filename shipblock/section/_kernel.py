@@ -1,20 +1,15 @@
-"""Compiled kernel of the dock-section model: forces, events and the event-driven integrator.
+"""Compiled kernel of the dock-section model: events and the event-driven integrator.
 
-The section is a set of rigid bodies in the transverse plane (body 0 the ship; then every moving
-block line), each with state ``(y, z, angle)`` in the floor's frame, joined by *strips*: the cap
-of a block face (carried by body ``C``: a moving line, or a fixed line whose pose is given)
-pressed against a straight surface of body ``S`` (the ship's hull, or the floor). A strip holds
-``n`` compression-only springs at Gauss-Lobatto points of the face and one tangential stick spring
-at the face's centre. :mod:`shipblock.section.model` explains every law; this module only
-evaluates them.
-
-State vector: ``q`` (3 per body), ``v`` (3 per body), ``u`` (stick-spring extension per strip),
-then the running integrals ``W_ground, W_wind, D_damping, D_friction`` (not error-controlled).
+The equations of motion and the contact laws are :mod:`shipblock.section._forces` (their
+layout constants and functions are re-exported here, the name callers use).
 
 Integrator: Dormand-Prince 5(4) with Hairer's 4th-order dense output; events (a spring
 closing, detaching, starting or ending to crush; a strip sticking, slipping; failures) are
 sign changes of event functions between the ends of an accepted step, located on the dense
-output by bisection, and the run restarts just past the earliest one.
+output by bisection, and the run restarts just past the earliest one. Between events every
+spring's law is linear in its closure, so the inner stages evaluate each strip's force and
+moment from sums over its springs kept per regime (:func:`regime_sums`, :func:`stage_rhs`);
+the last stage, whose forces the event functions and peaks reuse, evaluates every spring.
 """
 
 from __future__ import annotations
@@ -24,18 +19,13 @@ import math
 import numpy as np
 from numba import njit
 
-# --- layout of the strip and spring tables -------------------------------------------------
-SF_SQY, SF_SQZ, SF_SNY, SF_SNZ, SF_CY, SF_CZ, SF_KT, SF_CT, SF_MUS, SF_MUK = range(10)
-SF_PY, SF_PZ, SF_PA = 10, 11, 12  # fixed pose of C when C is not a body
-N_SF = 13
-SI_C, SI_S, SI_FIRST, SI_COUNT = range(4)
-N_SI = 4
-PF_RY, PF_RZ, PF_K, PF_C, PF_FY, PF_AREA = range(6)
-N_PF = 6
-
-# --- regimes -----------------------------------------------------------------------------
-R_FREE, R_ELASTIC, R_CRUSH = 0, 1, 2  # spring: not carrying / elastic / crushing
-F_STICK, F_FREE = 0, 2  # strip: stick, +1/-1 slip in that direction of v_t, free (no load)
+from shipblock.section._forces import (  # the layout and laws, also for K.<name> users
+    F_FREE, F_STICK, N_OPT, N_PF, N_RS, N_SF, N_SI, O_G, O_KEEL_B, O_KEEL_TOP_Y, O_KEEL_TOP_Z,
+    O_MAX_ANGLE, O_MAX_DISP, O_ROLL_HELD, O_SEP, O_SHIP_KY, O_SHIP_KZ, O_TIP_NEG, O_TIP_POS,
+    O_WIND_F, O_WIND_Y, O_WIND_Z, PF_AREA, PF_C, PF_FY, PF_K, PF_RY, PF_RZ, R_CRUSH, R_ELASTIC,
+    R_FREE, SF_CT, SF_CY, SF_CZ, SF_KT, SF_MUK, SF_MUS, SF_PA, SF_PY, SF_PZ, SF_SNY, SF_SNZ,
+    SF_SQY, SF_SQZ, SI_C, SI_COUNT, SI_FIRST, SI_S, cap_surface, contact_forces, kinematics,
+    regime_sums, rhs, stage_rhs)
 
 # --- event kinds (codes in the event log) -------------------------------------------------
 EV_START, EV_CLOSE, EV_DETACH, EV_CRUSH, EV_UNLOAD, EV_SLIP, EV_STICK = 0, 1, 2, 3, 4, 5, 6
@@ -43,246 +33,11 @@ EV_STRIP_OPEN, EV_STRIP_CLOSE = 7, 8
 EV_OVERTURN, EV_SLID_OFF, EV_TIP, EV_SEPARATION, EV_INVALID, EV_STALL = 10, 11, 12, 13, 14, 15
 EV_END = 20
 
-# --- options vector --------------------------------------------------------------------------
-O_G, O_WIND_F, O_WIND_Y, O_WIND_Z, O_ROLL_HELD, O_SEP, O_TIP_POS, O_TIP_NEG = range(8)
-O_KEEL_B, O_KEEL_TOP_Y, O_KEEL_TOP_Z, O_SHIP_KY, O_SHIP_KZ = 8, 9, 10, 11, 12
-O_MAX_ANGLE, O_MAX_DISP = 13, 14
-N_OPT = 15
-
 # --- running totals (acc) ------------------------------------------------------------------------
 A_FRIC_EVENT, A_CAP_RELAX = 0, 1
 N_ACC = 2
 
 BIG = 1e300
-
-
-@njit(cache=True, inline="always")
-def _pose(x, body, fy, fz, fa):
-    if body < 0:
-        return fy, fz, fa
-    return x[3 * body], x[3 * body + 1], x[3 * body + 2]
-
-
-@njit(cache=True, inline="always")
-def _vel(x, nb, body):
-    if body < 0:
-        return 0.0, 0.0, 0.0
-    o = 3 * nb + 3 * body
-    return x[o], x[o + 1], x[o + 2]
-
-
-@njit(cache=True, inline="always")
-def _trig(body, angle):
-    """cos and sin of a pose's angle; the floor's zero angle without a call (the same values)."""
-    if body < 0 and angle == 0.0:
-        return 1.0, 0.0
-    return math.cos(angle), math.sin(angle)
-
-
-@njit(cache=True, inline="always")
-def _frame(x, nb, j, strip_f, strip_i):
-    """What every spring of strip j needs, so that a spring costs a few products.
-
-    With C's pose ``(c, R_C)``, S's ``(s, R_S)``, a spring at ``rho = R_C r`` from c (``r`` its
-    point in C's frame), S's surface point ``q`` and normal ``n``, and ``w = omega_S - omega_C``:
-    closure ``delta = D0 - r . a`` with ``a = R_C^T n``; the moment arm ``m = rho x n = r x a``;
-    closure rate ``delta_dot = E0 + w m``; the force ``f n`` at the spring has the moment
-    ``f m`` about c and ``-f (L0 + m)`` about s. Returns ``(cb, sb, ny, nz, a1, a2, D0, E0, w, L0,
-    cy, cz, cc, cs, T0, P0)``; ``T0`` and ``P0`` give the tangential slip rate and the moment
-    about s of a tangential force at a point of C (see :func:`rhs`).
-    """
-    cb, sb = strip_i[j, SI_C], strip_i[j, SI_S]
-    cy, cz, ca = _pose(x, cb, strip_f[j, SF_PY], strip_f[j, SF_PZ], strip_f[j, SF_PA])
-    sy, sz, sa = _pose(x, sb, 0.0, 0.0, 0.0)
-    cvy, cvz, cw = _vel(x, nb, cb)
-    svy, svz, sw = _vel(x, nb, sb)
-    cc, cs = _trig(cb, ca)
-    sc, ss = _trig(sb, sa)
-    ny = sc * strip_f[j, SF_SNY] - ss * strip_f[j, SF_SNZ]
-    nz = ss * strip_f[j, SF_SNY] + sc * strip_f[j, SF_SNZ]
-    qy = sy + sc * strip_f[j, SF_SQY] - ss * strip_f[j, SF_SQZ]
-    qz = sz + ss * strip_f[j, SF_SQY] + sc * strip_f[j, SF_SQZ]
-    a1 = cc * ny + cs * nz
-    a2 = cc * nz - cs * ny
-    dy, dz = cy - sy, cz - sz
-    d0 = (qy - cy) * ny + (qz - cz) * nz
-    # relative velocity of S's and C's points at c
-    ry_ = svy - cvy - sw * dz
-    rz_ = svz - cvz + sw * dy
-    e0 = ry_ * ny + rz_ * nz
-    t0 = ry_ * nz - rz_ * ny
-    return (cb, sb, ny, nz, a1, a2, d0, e0, sw - cw, dy * nz - dz * ny, cy, cz, cc, cs, t0,
-            dy * ny + dz * nz)
-
-
-@njit(cache=True, inline="always")
-def kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
-    """Closure and closure rate of every spring, tangential slip rate of every strip.
-
-    ``pos[i] = (py, pz)`` is the world position of spring i's point on C (where its force acts).
-    """
-    for j in range(strip_i.shape[0]):
-        (cb, sb, ny, nz, a1, a2, d0, e0, w, l0, cy, cz, cc, cs, t0,
-         p0) = _frame(x, nb, j, strip_f, strip_i)
-        first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
-        for i in range(first, first + count):
-            ry, rz = spring_f[i, PF_RY], spring_f[i, PF_RZ]
-            pos[i, 0] = cy + cc * ry - cs * rz
-            pos[i, 1] = cz + cs * ry + cc * rz
-            delta[i] = d0 - (ry * a1 + rz * a2)
-            delta_dot[i] = e0 + w * (ry * a2 - rz * a1)
-        # tangent t = (n_z, -n_y): (1, 0) on the floor; C's face centre slips at w (r . a) - T0
-        vt[j] = w * (strip_f[j, SF_CY] * a1 + strip_f[j, SF_CZ] * a2) - t0
-
-
-@njit(cache=True, inline="always")
-def cap_surface(k, c, dp, dc0, t0, t):
-    """Compression of a detached cap at time t: it relaxes from dc0 towards its set dp."""
-    if c <= 0.0 or dc0 <= dp:
-        return dp
-    return dp + (dc0 - dp) * math.exp(-(k / c) * (t - t0))
-
-
-@njit(cache=True, inline="always")
-def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, delta_dot, vt,
-                   fe, fn, normal, tang):
-    """Spring forces (total ``fn``, elastic ``fe``) and strip normal/tangential forces."""
-    for j in range(strip_i.shape[0]):
-        first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
-        total = 0.0
-        for i in range(first, first + count):
-            k, c, fy = spring_f[i, PF_K], spring_f[i, PF_C], spring_f[i, PF_FY]
-            if reg[i] == R_ELASTIC:
-                fe[i] = k * (delta[i] - dp[i])
-                fn[i] = fe[i] + c * delta_dot[i]
-            elif reg[i] == R_CRUSH:
-                fe[i] = fy
-                fn[i] = fy + c * delta_dot[i]
-            else:
-                fe[i] = 0.0
-                fn[i] = 0.0
-            total += fn[i]
-        normal[j] = total
-        if fs[j] == F_STICK:
-            tang[j] = -strip_f[j, SF_KT] * x[o_u + j] - strip_f[j, SF_CT] * vt[j]
-        elif fs[j] == F_FREE:
-            tang[j] = 0.0
-        else:
-            tang[j] = -fs[j] * strip_f[j, SF_MUK] * total
-
-
-@njit(cache=True)
-def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
-        dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, xdot):
-    """Time derivative of the state (Newton-Euler of every body, contact laws, energy rates).
-
-    One pass per strip does what :func:`kinematics` and :func:`contact_forces` do (the same
-    formulas, :func:`_frame`, filling the same work arrays) and applies the strip's resultant
-    force and moment to C and S once: the hot loop of the integrator (6 calls per step).
-    """
-    o_v = 3 * nb
-    o_u = 6 * nb
-    # ground acceleration, linear between samples
-    s = t / dt_rec
-    k = int(s)
-    if k >= ag_y.shape[0] - 1:
-        ay, az = ag_y[-1], ag_z[-1]
-    else:
-        w = s - k
-        ay = ag_y[k] + w * (ag_y[k + 1] - ag_y[k])
-        az = ag_z[k] + w * (ag_z[k + 1] - ag_z[k])
-    g = opt[O_G]
-    for b in range(nb):
-        xdot[3 * b] = x[o_v + 3 * b]
-        xdot[3 * b + 1] = x[o_v + 3 * b + 1]
-        xdot[3 * b + 2] = x[o_v + 3 * b + 2]
-        xdot[o_v + 3 * b] = -mass[b] * ay
-        xdot[o_v + 3 * b + 1] = -mass[b] * (g + az)
-        xdot[o_v + 3 * b + 2] = 0.0
-    d_damp = 0.0
-    d_fric = 0.0
-    for j in range(ns):
-        (cb, sb, ny, nz, a1, a2, d0, e0, w, l0, cy, cz, cc, cs, t0,
-         p0) = _frame(x, nb, j, strip_f, strip_i)
-        first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
-        total = 0.0
-        moment = 0.0  # sum of f m: the springs' moment about c
-        for i in range(first, first + count):
-            ry, rz = spring_f[i, PF_RY], spring_f[i, PF_RZ]
-            m = ry * a2 - rz * a1
-            di = d0 - (ry * a1 + rz * a2)
-            ddi = e0 + w * m
-            delta[i] = di
-            delta_dot[i] = ddi
-            c = spring_f[i, PF_C]
-            ri = reg[i]
-            if ri == R_ELASTIC:
-                fei = spring_f[i, PF_K] * (di - dp[i])
-                f = fei + c * ddi
-                d_damp += c * ddi * ddi
-            elif ri == R_CRUSH:
-                fei = spring_f[i, PF_FY]
-                f = fei + c * ddi
-                d_damp += c * ddi * ddi
-            else:
-                fei = 0.0
-                f = 0.0
-            fe[i] = fei
-            fn[i] = f
-            total += f
-            moment += f * m
-        normal[j] = total
-        # C's face centre: tangential slip rate, stick spring or kinetic friction
-        dc = strip_f[j, SF_CY] * a1 + strip_f[j, SF_CZ] * a2
-        vtj = w * dc - t0
-        vt[j] = vtj
-        if fs[j] == F_STICK:
-            ft = -strip_f[j, SF_KT] * x[o_u + j] - strip_f[j, SF_CT] * vtj
-            xdot[o_u + j] = vtj
-            d_damp += strip_f[j, SF_CT] * vtj * vtj
-        elif fs[j] == F_FREE:
-            ft = 0.0
-            xdot[o_u + j] = 0.0
-        else:
-            ft = -fs[j] * strip_f[j, SF_MUK] * total
-            xdot[o_u + j] = 0.0
-            d_fric += -ft * vtj
-        tang[j] = ft
-        # normal force total n and tangential ft t (t = (n_z, -n_y)) on C, the opposite on S
-        fy_ = total * ny + ft * nz
-        fz_ = total * nz - ft * ny
-        if cb >= 0:
-            xdot[o_v + 3 * cb] += fy_
-            xdot[o_v + 3 * cb + 1] += fz_
-            xdot[o_v + 3 * cb + 2] += moment - ft * dc
-        if sb >= 0:
-            xdot[o_v + 3 * sb] -= fy_
-            xdot[o_v + 3 * sb + 1] -= fz_
-            xdot[o_v + 3 * sb + 2] += ft * (p0 + dc) - total * l0 - moment
-    # wind on the ship at its point (O_WIND_Y, O_WIND_Z) in the ship's frame
-    fw = opt[O_WIND_F]
-    w_wind = 0.0
-    if fw != 0.0:
-        ca, sa = math.cos(x[2]), math.sin(x[2])
-        rz = sa * opt[O_WIND_Y] + ca * opt[O_WIND_Z]
-        xdot[o_v] += fw
-        xdot[o_v + 2] += -rz * fw
-        w_wind = fw * (x[o_v] - x[o_v + 2] * rz)
-    w_ground = 0.0
-    for b in range(nb):
-        o = o_v + 3 * b
-        w_ground -= mass[b] * (ay * x[o] + az * x[o + 1])
-        xdot[o] /= mass[b]
-        xdot[o + 1] /= mass[b]
-        xdot[o + 2] /= inertia[b]
-    if opt[O_ROLL_HELD] != 0.0:
-        xdot[2] = 0.0
-        xdot[o_v + 2] = 0.0
-    o_e = o_u + ns
-    xdot[o_e] = w_ground
-    xdot[o_e + 1] = w_wind
-    xdot[o_e + 2] = d_damp
-    xdot[o_e + 3] = d_fric
 
 
 @njit(cache=True)
@@ -408,6 +163,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     g0 = np.zeros(ng)
     g1 = np.zeros(ng)
     ge = np.zeros(ng)
+    sums = np.zeros((ns, N_RS))
     t = 0.0
     n_ev = 0
     ev_t[0] = 0.0
@@ -438,6 +194,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     failure, n_ev = _settle(t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs,
                             opt, delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0,
                             acc, n_ev, ev_t, ev_kind, ev_index)
+    regime_sums(strip_i, spring_f, reg, dp, sums)
     rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
         dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
     event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
@@ -453,25 +210,25 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             break
         for m in range(nx):
             y[m] = x[m] + h * _A21 * k1[m]
-        rhs(t + h / 5.0, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
-            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k2)
+        stage_rhs(t + h / 5.0, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
+                  dt_rec, sums, k2)
         for m in range(nx):
             y[m] = x[m] + h * (_A31 * k1[m] + _A32 * k2[m])
-        rhs(t + 0.3 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
-            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k3)
+        stage_rhs(t + 0.3 * h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
+                  dt_rec, sums, k3)
         for m in range(nx):
             y[m] = x[m] + h * (_A41 * k1[m] + _A42 * k2[m] + _A43 * k3[m])
-        rhs(t + 0.8 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
-            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k4)
+        stage_rhs(t + 0.8 * h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
+                  dt_rec, sums, k4)
         for m in range(nx):
             y[m] = x[m] + h * (_A51 * k1[m] + _A52 * k2[m] + _A53 * k3[m] + _A54 * k4[m])
-        rhs(t + 8.0 / 9.0 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs,
-            opt, ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k5)
+        stage_rhs(t + 8.0 / 9.0 * h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
+                  dt_rec, sums, k5)
         for m in range(nx):
             y[m] = x[m] + h * (_A61 * k1[m] + _A62 * k2[m] + _A63 * k3[m] + _A64 * k4[m]
                                + _A65 * k5[m])
-        rhs(t + h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
-            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k6)
+        stage_rhs(t + h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
+                  dt_rec, sums, k6)
         for m in range(nx):
             x1[m] = x[m] + h * (_B1 * k1[m] + _B3 * k3[m] + _B4 * k4[m] + _B5 * k5[m]
                                 + _B6 * k6[m])
@@ -596,6 +353,8 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             for q in range(ng):
                 g0[q] = g1[q]
         else:
+            # the regimes or sets changed at the event
+            regime_sums(strip_i, spring_f, reg, dp, sums)
             rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y,
                 ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
             event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
