@@ -229,3 +229,22 @@ def test_normal_impact_restitution_follows_the_damping_mapping(zeta):
     assert -v_out / v_in == pytest.approx(impact_restitution(zeta), rel=3e-3, abs=1e-4)
     if zeta > 0:
         assert damping_for_restitution(impact_restitution(zeta)) == pytest.approx(zeta, rel=1e-9)
+
+
+def test_batch_gives_the_runs_summaries():
+    """The batch entry point (one static solve for all its motions) returns exactly the summary
+    and energy residual of each motion run on its own, with the same options; a bad option is
+    refused before any run, naming it."""
+    from shipblock.errors import ParameterError
+    from shipblock.section.simulate import simulate_section_batch
+
+    sec = dock(damping=0.15)
+    motions = [strong_motion(0.5, duration=3.0, seed=s) for s in (4, 5)]
+    batch = simulate_section_batch(sec, motions, rtol=1e-7, separation_height=0.05)
+    assert len(batch) == 2
+    for entry, (h, v, dt) in zip(batch, motions, strict=True):
+        res = simulate_section(sec, h, v, dt, rtol=1e-7, separation_height=0.05)
+        assert entry == {**res.summary, "energy_residual": res.energy["residual"]}
+    assert batch[0] != batch[1]
+    with pytest.raises(ParameterError, match="rtol"):
+        simulate_section_batch(sec, motions, rtol=1.0)

@@ -2,18 +2,23 @@
 line and two moving side lines, Navy-block defaults; and the rigid solver on the same record.
 
 Part of ``shipblock bench`` (target: 50 ms of one core per run); ``python -m
-shipblock.bench.section`` prints the JSON alone.
+shipblock.bench.section`` prints the JSON alone, ``python -m shipblock.bench.section --study``
+also times a small study (:func:`section_study`: 200 runs in 2 processes, extrapolated to the
+target's 10,000 runs on 2 cores in 10 minutes).
 """
 
 from __future__ import annotations
 
 import json
+import sys
 import time
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
+from shipblock.bench.targets import TARGETS
 from shipblock.section import NAVY_BLOCK, Block, BlockLine, DockSection, Ship
-from shipblock.section.simulate import simulate_section
+from shipblock.section.simulate import simulate_section, simulate_section_batch
 from shipblock.solver import simulate
 from shipblock.system import ShipBlockSystem
 from shipblock.units import STANDARD_GRAVITY
@@ -75,5 +80,41 @@ def section_speed(repeats=5) -> dict:
     }
 
 
+def _study_share(seeds):
+    """One process's share of :func:`section_study`: the batch of its seeds' records, timed
+    after a short compile/warm-up run (CPU and wall seconds, failures)."""
+    dock = navy_dock()
+    h, v, dt = record()
+    simulate_section(dock, h[:400], v[:400], dt)
+    motions = [record(pga=0.2 + 0.4 * ((s * 0.618034) % 1.0), seed=s)
+               for s in seeds]
+    c0, w0 = time.process_time(), time.perf_counter()
+    out = simulate_section_batch(dock, motions)
+    return (time.process_time() - c0, time.perf_counter() - w0,
+            sum(r["failure"] is not None for r in out))
+
+
+def section_study(n_runs=200, processes=2, target_runs=10_000) -> dict:
+    """A study's cost: ``n_runs`` records (seeded, PGA 0.2-0.6 g, 40 s at 200 Hz) on the
+    benchmark dock through :func:`simulate_section_batch`, split over ``processes`` processes
+    started together; the wall time of the slowest share extrapolated linearly to
+    ``target_runs`` (the target: 10,000 runs on 2 cores within 600 s), and the CPU time per run
+    times ``target_runs / processes`` (what free cores would take)."""
+    shares = [list(range(1000 + k, 1000 + n_runs, processes)) for k in range(processes)]
+    with ProcessPoolExecutor(processes) as pool:
+        res = list(pool.map(_study_share, shares))
+    wall = max(r[1] for r in res)
+    cpu = sum(r[0] for r in res) / n_runs
+    # on a shared machine the wall time holds the other users' load; the CPU time per run over
+    # the processes is what two free cores would take
+    return {"runs": n_runs, "processes": processes, "wall_seconds": wall,
+            "cpu_seconds_per_run": cpu, "failures": sum(r[2] for r in res),
+            "extrapolated_wall_seconds": wall * target_runs / n_runs,
+            "extrapolated_cpu_seconds_on_free_cores": cpu * target_runs / processes,
+            "target_runs": target_runs, "target_seconds": TARGETS["section_study_seconds"]}
+
+
 if __name__ == "__main__":
     print(json.dumps(section_speed(), indent=1))
+    if "--study" in sys.argv[1:]:
+        print(json.dumps(section_study(), indent=1))

@@ -1,20 +1,15 @@
-"""Compiled kernel of the dock-section model: forces, events and the event-driven integrator.
+"""Compiled kernel of the dock-section model: events and the event-driven integrator.
 
-The section is a set of rigid bodies in the transverse plane (body 0 the ship; then every moving
-block line), each with state ``(y, z, angle)`` in the floor's frame, joined by *strips*: the cap
-of a block face (carried by body ``C``: a moving line, or a fixed line whose pose is given)
-pressed against a straight surface of body ``S`` (the ship's hull, or the floor). A strip holds
-``n`` compression-only springs at Gauss-Lobatto points of the face and one tangential stick spring
-at the face's centre. :mod:`shipblock.section.model` explains every law; this module only
-evaluates them.
-
-State vector: ``q`` (3 per body), ``v`` (3 per body), ``u`` (stick-spring extension per strip),
-then the running integrals ``W_ground, W_wind, D_damping, D_friction`` (not error-controlled).
+The equations of motion and the contact laws are :mod:`shipblock.section._forces` (their
+layout constants and functions are re-exported here, the name callers use).
 
 Integrator: Dormand-Prince 5(4) with Hairer's 4th-order dense output; events (a spring
 closing, detaching, starting or ending to crush; a strip sticking, slipping; failures) are
 sign changes of event functions between the ends of an accepted step, located on the dense
-output by bisection, and the run restarts just past the earliest one.
+output by bisection, and the run restarts just past the earliest one. Between events every
+spring's law is linear in its closure, so the inner stages evaluate each strip's force and
+moment from sums over its springs kept per regime (:func:`regime_sums`, :func:`stage_rhs`);
+the last stage, whose forces the event functions and peaks reuse, evaluates every spring.
 """
 
 from __future__ import annotations
@@ -24,30 +19,19 @@ import math
 import numpy as np
 from numba import njit
 
-# --- layout of the strip and spring tables -------------------------------------------------
-SF_SQY, SF_SQZ, SF_SNY, SF_SNZ, SF_CY, SF_CZ, SF_KT, SF_CT, SF_MUS, SF_MUK = range(10)
-SF_PY, SF_PZ, SF_PA = 10, 11, 12  # fixed pose of C when C is not a body
-N_SF = 13
-SI_C, SI_S, SI_FIRST, SI_COUNT = range(4)
-N_SI = 4
-PF_RY, PF_RZ, PF_K, PF_C, PF_FY, PF_AREA = range(6)
-N_PF = 6
-
-# --- regimes -----------------------------------------------------------------------------
-R_FREE, R_ELASTIC, R_CRUSH = 0, 1, 2  # spring: not carrying / elastic / crushing
-F_STICK, F_FREE = 0, 2  # strip: stick, +1/-1 slip in that direction of v_t, free (no load)
+from shipblock.section._forces import (  # the layout and laws, also for K.<name> users
+    F_FREE, F_STICK, N_OPT, N_PF, N_RS, N_SF, N_SI, O_G, O_KEEL_B, O_KEEL_TOP_Y, O_KEEL_TOP_Z,
+    O_MAX_ANGLE, O_MAX_DISP, O_ROLL_HELD, O_SEP, O_SHIP_KY, O_SHIP_KZ, O_TIP_NEG, O_TIP_POS,
+    O_WIND_F, O_WIND_Y, O_WIND_Z, PF_AREA, PF_C, PF_FY, PF_K, PF_RY, PF_RZ, R_CRUSH, R_ELASTIC,
+    R_FREE, SF_CT, SF_CY, SF_CZ, SF_KT, SF_MUK, SF_MUS, SF_PA, SF_PY, SF_PZ, SF_SNY, SF_SNZ,
+    SF_SQY, SF_SQZ, SI_C, SI_COUNT, SI_FIRST, SI_S, cap_surface, contact_forces, kinematics,
+    regime_sums, rhs, stage_rhs)
 
 # --- event kinds (codes in the event log) -------------------------------------------------
 EV_START, EV_CLOSE, EV_DETACH, EV_CRUSH, EV_UNLOAD, EV_SLIP, EV_STICK = 0, 1, 2, 3, 4, 5, 6
 EV_STRIP_OPEN, EV_STRIP_CLOSE = 7, 8
 EV_OVERTURN, EV_SLID_OFF, EV_TIP, EV_SEPARATION, EV_INVALID, EV_STALL = 10, 11, 12, 13, 14, 15
 EV_END = 20
-
-# --- options vector --------------------------------------------------------------------------
-O_G, O_WIND_F, O_WIND_Y, O_WIND_Z, O_ROLL_HELD, O_SEP, O_TIP_POS, O_TIP_NEG = range(8)
-O_KEEL_B, O_KEEL_TOP_Y, O_KEEL_TOP_Z, O_SHIP_KY, O_SHIP_KZ = 8, 9, 10, 11, 12
-O_MAX_ANGLE, O_MAX_DISP = 13, 14
-N_OPT = 15
 
 # --- running totals (acc) ------------------------------------------------------------------------
 A_FRIC_EVENT, A_CAP_RELAX = 0, 1
@@ -56,201 +40,22 @@ N_ACC = 2
 BIG = 1e300
 
 
-@njit(cache=True, inline="always")
-def _pose(x, body, fy, fz, fa):
-    if body < 0:
-        return fy, fz, fa
-    return x[3 * body], x[3 * body + 1], x[3 * body + 2]
-
-
-@njit(cache=True, inline="always")
-def _vel(x, nb, body):
-    if body < 0:
-        return 0.0, 0.0, 0.0
-    o = 3 * nb + 3 * body
-    return x[o], x[o + 1], x[o + 2]
-
-
-@njit(cache=True, inline="always")
-def kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
-    """Closure and closure rate of every spring, tangential slip rate of every strip.
-
-    ``pos[i] = (py, pz)`` is the world position of spring i's point on C (where its force acts).
-    """
-    for j in range(strip_i.shape[0]):
-        cb, sb = strip_i[j, SI_C], strip_i[j, SI_S]
-        cy, cz, ca = _pose(x, cb, strip_f[j, SF_PY], strip_f[j, SF_PZ], strip_f[j, SF_PA])
-        sy, sz, sa = _pose(x, sb, 0.0, 0.0, 0.0)
-        cvy, cvz, cw = _vel(x, nb, cb)
-        svy, svz, sw = _vel(x, nb, sb)
-        cc, cs = math.cos(ca), math.sin(ca)
-        sc, ss = math.cos(sa), math.sin(sa)
-        ny = sc * strip_f[j, SF_SNY] - ss * strip_f[j, SF_SNZ]
-        nz = ss * strip_f[j, SF_SNY] + sc * strip_f[j, SF_SNZ]
-        qy = sy + sc * strip_f[j, SF_SQY] - ss * strip_f[j, SF_SQZ]
-        qz = sz + ss * strip_f[j, SF_SQY] + sc * strip_f[j, SF_SQZ]
-        first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
-        for i in range(first, first + count):
-            ry, rz = spring_f[i, PF_RY], spring_f[i, PF_RZ]
-            py = cy + cc * ry - cs * rz
-            pz = cz + cs * ry + cc * rz
-            pos[i, 0] = py
-            pos[i, 1] = pz
-            delta[i] = (qy - py) * ny + (qz - pz) * nz
-            # velocities of the body-fixed points of S and C at p
-            vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
-            vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
-            delta_dot[i] = (vsy - vcy) * ny + (vsz - vcz) * nz
-        ry, rz = strip_f[j, SF_CY], strip_f[j, SF_CZ]
-        py = cy + cc * ry - cs * rz
-        pz = cz + cs * ry + cc * rz
-        vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
-        vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
-        # tangent t = (n_z, -n_y): (1, 0) on the floor
-        vt[j] = (vcy - vsy) * nz - (vcz - vsz) * ny
-
-
-@njit(cache=True, inline="always")
-def cap_surface(k, c, dp, dc0, t0, t):
-    """Compression of a detached cap at time t: it relaxes from dc0 towards its set dp."""
-    if c <= 0.0 or dc0 <= dp:
-        return dp
-    return dp + (dc0 - dp) * math.exp(-(k / c) * (t - t0))
-
-
-@njit(cache=True, inline="always")
-def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, delta_dot, vt,
-                   fe, fn, normal, tang):
-    """Spring forces (total ``fn``, elastic ``fe``) and strip normal/tangential forces."""
-    for j in range(strip_i.shape[0]):
-        first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
-        total = 0.0
-        for i in range(first, first + count):
-            k, c, fy = spring_f[i, PF_K], spring_f[i, PF_C], spring_f[i, PF_FY]
-            if reg[i] == R_ELASTIC:
-                fe[i] = k * (delta[i] - dp[i])
-                fn[i] = fe[i] + c * delta_dot[i]
-            elif reg[i] == R_CRUSH:
-                fe[i] = fy
-                fn[i] = fy + c * delta_dot[i]
-            else:
-                fe[i] = 0.0
-                fn[i] = 0.0
-            total += fn[i]
-        normal[j] = total
-        if fs[j] == F_STICK:
-            tang[j] = -strip_f[j, SF_KT] * x[o_u + j] - strip_f[j, SF_CT] * vt[j]
-        elif fs[j] == F_FREE:
-            tang[j] = 0.0
-        else:
-            tang[j] = -fs[j] * strip_f[j, SF_MUK] * total
-
-
-@njit(cache=True)
-def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
-        dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, xdot):
-    """Time derivative of the state (Newton-Euler of every body, contact laws, energy rates)."""
-    kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
-    o_u = 6 * nb
-    contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
-                   delta_dot, vt, fe, fn, normal, tang)
-    # ground acceleration, linear between samples
-    s = t / dt_rec
-    k = int(s)
-    if k >= ag_y.shape[0] - 1:
-        ay, az = ag_y[-1], ag_z[-1]
-    else:
-        w = s - k
-        ay = ag_y[k] + w * (ag_y[k + 1] - ag_y[k])
-        az = ag_z[k] + w * (ag_z[k + 1] - ag_z[k])
-    g = opt[O_G]
-    for b in range(nb):
-        xdot[3 * b] = x[3 * nb + 3 * b]
-        xdot[3 * b + 1] = x[3 * nb + 3 * b + 1]
-        xdot[3 * b + 2] = x[3 * nb + 3 * b + 2]
-        xdot[3 * nb + 3 * b] = -mass[b] * ay
-        xdot[3 * nb + 3 * b + 1] = -mass[b] * (g + az)
-        xdot[3 * nb + 3 * b + 2] = 0.0
-    d_damp = 0.0
-    d_fric = 0.0
-    for j in range(ns):
-        cb, sb = strip_i[j, SI_C], strip_i[j, SI_S]
-        cy, cz, ca = _pose(x, cb, strip_f[j, SF_PY], strip_f[j, SF_PZ], strip_f[j, SF_PA])
-        sy, sz, sa = _pose(x, sb, 0.0, 0.0, 0.0)
-        sc, ss = math.cos(sa), math.sin(sa)
-        ny = sc * strip_f[j, SF_SNY] - ss * strip_f[j, SF_SNZ]
-        nz = ss * strip_f[j, SF_SNY] + sc * strip_f[j, SF_SNZ]
-        first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
-        for i in range(first, first + count):
-            f = fn[i]
-            if reg[i] != R_FREE:
-                d_damp += spring_f[i, PF_C] * delta_dot[i] * delta_dot[i]
-            if f == 0.0:
-                continue
-            py, pz = pos[i, 0], pos[i, 1]
-            fy_, fz_ = f * ny, f * nz
-            if cb >= 0:
-                xdot[3 * nb + 3 * cb] += fy_
-                xdot[3 * nb + 3 * cb + 1] += fz_
-                xdot[3 * nb + 3 * cb + 2] += (py - cy) * fz_ - (pz - cz) * fy_
-            if sb >= 0:
-                xdot[3 * nb + 3 * sb] -= fy_
-                xdot[3 * nb + 3 * sb + 1] -= fz_
-                xdot[3 * nb + 3 * sb + 2] -= (py - sy) * fz_ - (pz - sz) * fy_
-        ft = tang[j]
-        xdot[o_u + j] = vt[j] if fs[j] == F_STICK else 0.0
-        if fs[j] == F_STICK:
-            d_damp += strip_f[j, SF_CT] * vt[j] * vt[j]
-        elif fs[j] != F_FREE:
-            d_fric += -ft * vt[j]
-        if ft != 0.0:
-            cc, cs = math.cos(ca), math.sin(ca)
-            ry, rz = strip_f[j, SF_CY], strip_f[j, SF_CZ]
-            py = cy + cc * ry - cs * rz
-            pz = cz + cs * ry + cc * rz
-            fy_, fz_ = ft * nz, -ft * ny  # along t = (n_z, -n_y)
-            if cb >= 0:
-                xdot[3 * nb + 3 * cb] += fy_
-                xdot[3 * nb + 3 * cb + 1] += fz_
-                xdot[3 * nb + 3 * cb + 2] += (py - cy) * fz_ - (pz - cz) * fy_
-            if sb >= 0:
-                xdot[3 * nb + 3 * sb] -= fy_
-                xdot[3 * nb + 3 * sb + 1] -= fz_
-                xdot[3 * nb + 3 * sb + 2] -= (py - sy) * fz_ - (pz - sz) * fy_
-    # wind on the ship at its point (O_WIND_Y, O_WIND_Z) in the ship's frame
-    fw = opt[O_WIND_F]
-    w_wind = 0.0
-    if fw != 0.0:
-        ca, sa = math.cos(x[2]), math.sin(x[2])
-        rz = sa * opt[O_WIND_Y] + ca * opt[O_WIND_Z]
-        xdot[3 * nb] += fw
-        xdot[3 * nb + 2] += -rz * fw
-        w_wind = fw * (x[3 * nb] - x[3 * nb + 2] * rz)
-    w_ground = 0.0
-    for b in range(nb):
-        o = 3 * nb + 3 * b
-        w_ground -= mass[b] * (ay * x[o] + az * x[o + 1])
-        xdot[o] /= mass[b]
-        xdot[o + 1] /= mass[b]
-        xdot[o + 2] /= inertia[b]
-    if opt[O_ROLL_HELD] != 0.0:
-        xdot[2] = 0.0
-        xdot[3 * nb + 2] = 0.0
-    o_e = o_u + ns
-    xdot[o_e] = w_ground
-    xdot[o_e + 1] = w_wind
-    xdot[o_e + 2] = d_damp
-    xdot[o_e + 3] = d_fric
-
-
 @njit(cache=True)
 def event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
                  delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, gv):
     """Event functions of the current regimes: an event happens when one goes from > 0 to <= 0."""
     kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
-    o_u = 6 * nb
-    contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
+    contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
                    delta_dot, vt, fe, fn, normal, tang)
+    _event_values_of(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
+                     delta, delta_dot, vt, fe, fn, normal, tang, theta_c, gv)
+
+
+@njit(cache=True)
+def _event_values_of(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
+                     delta, delta_dot, vt, fe, fn, normal, tang, theta_c, gv):
+    """:func:`event_values` from the kinematics and contact forces of ``x`` already in the work
+    arrays (after :func:`rhs` at the same state and regimes)."""
     nsp = spring_f.shape[0]
     min_gap = BIG
     for j in range(ns):
@@ -358,6 +163,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     g0 = np.zeros(ng)
     g1 = np.zeros(ng)
     ge = np.zeros(ng)
+    sums = np.zeros((ns, N_RS))
     t = 0.0
     n_ev = 0
     ev_t[0] = 0.0
@@ -388,6 +194,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     failure, n_ev = _settle(t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs,
                             opt, delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0,
                             acc, n_ev, ev_t, ev_kind, ev_index)
+    regime_sums(strip_i, spring_f, reg, dp, sums)
     rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
         dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
     event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
@@ -403,25 +210,25 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             break
         for m in range(nx):
             y[m] = x[m] + h * _A21 * k1[m]
-        rhs(t + h / 5.0, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
-            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k2)
+        stage_rhs(t + h / 5.0, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
+                  dt_rec, sums, k2)
         for m in range(nx):
             y[m] = x[m] + h * (_A31 * k1[m] + _A32 * k2[m])
-        rhs(t + 0.3 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
-            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k3)
+        stage_rhs(t + 0.3 * h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
+                  dt_rec, sums, k3)
         for m in range(nx):
             y[m] = x[m] + h * (_A41 * k1[m] + _A42 * k2[m] + _A43 * k3[m])
-        rhs(t + 0.8 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
-            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k4)
+        stage_rhs(t + 0.8 * h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
+                  dt_rec, sums, k4)
         for m in range(nx):
             y[m] = x[m] + h * (_A51 * k1[m] + _A52 * k2[m] + _A53 * k3[m] + _A54 * k4[m])
-        rhs(t + 8.0 / 9.0 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs,
-            opt, ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k5)
+        stage_rhs(t + 8.0 / 9.0 * h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
+                  dt_rec, sums, k5)
         for m in range(nx):
             y[m] = x[m] + h * (_A61 * k1[m] + _A62 * k2[m] + _A63 * k3[m] + _A64 * k4[m]
                                + _A65 * k5[m])
-        rhs(t + h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
-            ag_y, ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k6)
+        stage_rhs(t + h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
+                  dt_rec, sums, k6)
         for m in range(nx):
             x1[m] = x[m] + h * (_B1 * k1[m] + _B3 * k3[m] + _B4 * k4[m] + _B5 * k5[m]
                                 + _B6 * k6[m])
@@ -451,8 +258,9 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             r[3, m] = d - h * k7[m] - r[2, m]
             r[4, m] = h * (_D1 * k1[m] + _D3 * k3[m] + _D4 * k4[m] + _D5 * k5[m] + _D6 * k6[m]
                            + _D7 * k7[m])
-        event_values(t + h, x1, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
-                     delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g1)
+        # the work arrays hold x1's kinematics and forces from the evaluation of k7
+        _event_values_of(t + h, x1, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs,
+                         opt, delta, delta_dot, vt, fe, fn, normal, tang, theta_c, g1)
         # the earliest event in the step, located by bisection on the dense output
         first = -1
         lo, hi = 0.0, 1.0
@@ -545,6 +353,8 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             for q in range(ng):
                 g0[q] = g1[q]
         else:
+            # the regimes or sets changed at the event
+            regime_sums(strip_i, spring_f, reg, dp, sums)
             rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y,
                 ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
             event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
