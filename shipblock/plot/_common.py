@@ -28,9 +28,9 @@ def _new_axes(nrows, sharex=True, height=1.8):
 #: title's).
 SUPTITLE_WIDTH = 140
 
-#: Longest title line of a study figure [characters]: about the width of the default figure
-#: at the title's font size.
-TITLE_WIDTH = 140
+#: Longest title line of a study figure [characters]: the width of the default figure's axes
+#: at the title's font size (140 ran past the right edge of a fragility figure).
+TITLE_WIDTH = 118
 
 
 def _title(ax, caption, what):
