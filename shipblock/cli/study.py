@@ -12,16 +12,18 @@ from shipblock.cli.simulate import _report, _response_figure, _response_figure_o
 
 
 def _parse_assignments(items):
-    """``["mu_ground=0.4", ...]`` -> ``{"mu_ground": 0.4}`` (numbers only)."""
+    """``["mu_ground=0.4", "cap_material=white_oak"]`` -> ``{"mu_ground": 0.4, "cap_material":
+    "white_oak"}``: a number where the text is one, else the text (a name of a string
+    dimension, checked against the study's values where it is used)."""
     values = {}
     for item in items or []:
         name, sep, text = item.partition("=")
-        if not sep or not name.strip():
+        if not sep or not name.strip() or not text.strip():
             raise UserError(f"--set expects NAME=VALUE, got {item!r}")
         try:
             values[name.strip()] = float(text)
         except ValueError:
-            raise UserError(f"--set {name.strip()}: {text!r} is not a number") from None
+            values[name.strip()] = text.strip()
     return values
 
 
