@@ -79,7 +79,8 @@ from shipblock.fragility.limit_states import LimitState, parse_limit_states
 from shipblock.models import DEFAULT_MODEL, FieldError, Model, get_model
 from shipblock.units import STANDARD_GRAVITY, acceleration_to_si, velocity_to_si
 
-__all__ = ["HistoryRequest", "Pipeline", "PipelineError", "load_pipeline", "parse_pipeline"]
+__all__ = ["HistoryRequest", "Pipeline", "PipelineError", "load_pipeline", "load_system",
+           "parse_pipeline"]
 
 logger = logging.getLogger(__name__)
 
@@ -231,6 +232,23 @@ class Pipeline:
         doc["records"] = {**{k: v for k, v in doc["records"].items() if k != "strict"},
                           "catalogue": str(self.catalogue), "ids": list(self.design.records)}
         return doc
+
+
+def load_system(path) -> tuple[Model, object]:
+    """``(model, system)`` of a file's ``[system]`` table, read as a pipeline's (its keys,
+    units and checks; ``model = "section"`` chooses the dock section), for a single run
+    (``shipblock simulate --system FILE``). Raises :class:`PipelineError` naming the file and
+    the key (``system.<key>``): unreadable, no ``[system]`` table, an invalid key or system."""
+    source = str(checks.pathname(path, "path", "a system TOML file"))
+    try:
+        table = checks.toml_file(source, "system file").get("system")
+    except ShipblockError as exc:
+        raise PipelineError("", str(exc), source) from None
+    if not isinstance(table, Mapping):
+        raise PipelineError("system", "missing: the file needs a [system] table", source)
+    model = _model(table, source)
+    check_table(table, "system", source, model)
+    return model, _system(table, model, source)
 
 
 def load_pipeline(path) -> Pipeline:

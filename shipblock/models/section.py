@@ -35,8 +35,8 @@ section's own constructors with the ``[system]`` key named (:meth:`SectionModel.
   ``block_length``, ``block_mass`` (default: concrete core and oak caps), ``block_capacity``;
 * the caps (top and bottom alike; defaults white oak): ``cap_thickness``, ``cap_material``
   (a timber of :data:`~shipblock.section.parameters.CAP_MATERIALS`, which gives the modulus
-  and the proportional limit) or ``cap_modulus`` and ``cap_proportional_limit`` (not both), ``cap_stiffness`` (default ``E A / t``), ``cap_damping_ratio``,
-  ``cap_shear_ratio``;
+  and the proportional limit) or ``cap_modulus`` and ``cap_proportional_limit`` (not both),
+  ``cap_stiffness`` (default ``E A / t``), ``cap_damping_ratio``, ``cap_shear_ratio``;
 * friction: ``mu_s_top``, ``mu_k_top`` (hull on the top caps), ``mu_s_bottom``,
   ``mu_k_bottom`` (blocks on the floor);
 * wind: ``wind_force``, or ``wind_pressure`` and ``wind_area``; ``wind_height``;
