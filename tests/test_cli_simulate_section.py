@@ -95,3 +95,14 @@ def test_a_bad_key_of_the_section_system_is_named(tmp_path, records, capsys):
     assert _simulate(tmp_path, records, system=SYSTEM.replace('"30 t"', '"30 m"')) != 0
     err = capsys.readouterr().err
     assert "[system.ship_mass]" in err
+
+
+def test_a_pipelines_rigid_system_table_runs_the_rigid_model(tmp_path, records, capsys):
+    """``model = "rigid"`` (a rigid pipeline's ``[system]``): the rigid model, with the system
+    flags applied to it."""
+    rigid = ('[system]\nmodel = "rigid"\nship_mass = "5000 t"\nblock_mass = "1.2 t"\n'
+             'n_blocks = 150\nhalf_width = 0.3\nhalf_height = 0.6\nmu_s_ground = 0.6\n'
+             'mu_k_ground = 0.55\nmu_s_ship = 0.35\nmu_k_ship = 0.3\n')
+    assert _simulate(tmp_path, records, "--n-blocks", "100", system=rigid) == 0
+    text = capsys.readouterr().out
+    assert "M = 5e+06 kg on 100 blocks of 1200 kg" in text and "peak ship slip" in text

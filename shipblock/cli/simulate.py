@@ -11,14 +11,17 @@ from shipblock.cli.reading import _horizontal_line, _load_motion
 from shipblock.units import STANDARD_GRAVITY
 
 
-def _system_from_args(args):
-    """The system of --system and the system flags; quantities with units converted to SI
-    (shipblock.quantities), and a warning for a system outside any dock
-    (shipblock.system.warn_implausible)."""
+def _system_from_args(args, base=None):
+    """The system of --system (or ``base``, read from it already) and the system flags;
+    quantities with units converted to SI (shipblock.quantities), and a warning for a system
+    outside any dock (shipblock.system.warn_implausible)."""
     from shipblock.quantities import to_si
     from shipblock.system import FIELD_UNITS, ShipBlockSystem, warn_implausible
 
-    system = ShipBlockSystem.from_toml(args.system) if args.system else ShipBlockSystem.example()
+    if base is not None:
+        system = base
+    else:
+        system = ShipBlockSystem.from_toml(args.system) if args.system else ShipBlockSystem.example()
     changes = {k: getattr(args, k) for k in SYSTEM_FLAGS if getattr(args, k) is not None}
     changes = {k: to_si(v, FIELD_UNITS[k], SYSTEM_FLAGS[k][0]) if k in FIELD_UNITS else v
                for k, v in changes.items()}
@@ -59,11 +62,12 @@ RIGID_RTOL = 1e-8
 
 
 def _model_system(args):
-    """``(model, system)`` of ``--system`` when its ``[system]`` names another model than the
-    rigid one (``model = "section"``: the keys of a pipeline's ``[system]``), else None.
+    """``(model, system)`` of ``--system`` when its ``[system]`` names its model (``model =
+    "section"`` or ``"rigid"``: read as a pipeline's ``[system]``), else None (a plain
+    :meth:`~shipblock.system.ShipBlockSystem.from_toml` table).
 
-    The rigid model's flags (``--n-blocks``, ...) are refused for such a system, naming the
-    flag; ``--ship-mass`` (a key of both) replaces its ``ship_mass``."""
+    The rigid model's flags (``--n-blocks``, ...) are refused for another model's system,
+    naming the flag; ``--ship-mass`` (a key of both) replaces its ``ship_mass``."""
     from shipblock.checks import toml_file
     from shipblock.fragility.schema import load_system
     from shipblock.models import DEFAULT_MODEL
@@ -71,8 +75,10 @@ def _model_system(args):
     if not args.system:
         return None
     table = toml_file(args.system, "system file").get("system")
-    if not isinstance(table, dict) or table.get("model", DEFAULT_MODEL) == DEFAULT_MODEL:
+    if not isinstance(table, dict) or "model" not in table:
         return None
+    if table["model"] == DEFAULT_MODEL:  # the flags apply as to a plain table
+        return load_system(args.system)
     given = [k for k in SYSTEM_FLAGS if getattr(args, k) is not None and k != "ship_mass"]
     if given:
         flag = SYSTEM_FLAGS[given[0]][0]
@@ -89,8 +95,14 @@ def cmd_simulate(args):
     from shipblock.plot import record_text
     from shipblock.solver import simulate
 
+    from shipblock.models import DEFAULT_MODEL
+
     chosen = _model_system(args)
-    system = _system_from_args(args) if chosen is None else chosen[1]
+    if chosen is None or chosen[0].name == DEFAULT_MODEL:
+        system = _system_from_args(args, None if chosen is None else chosen[1])
+        chosen = None
+    else:
+        system = chosen[1]
     motion = _load_motion(args)
     ax, ay, scale = _scaled_input(args, motion)
     log.info("simulating %d samples at dt = %g s", ax.size, motion.dt)
