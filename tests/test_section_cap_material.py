@@ -141,3 +141,21 @@ def test_a_bad_material_name_is_refused_naming_the_key(tmp_path):
     with pytest.raises(PipelineError) as err:
         load_pipeline(path)
     assert err.value.key == "system.cap_material" and "teak" in str(err.value)
+
+
+def test_plot_set_takes_a_name_for_names_and_a_number_for_numbers():
+    """``--set`` passes text that is not a number on as a name: matched exactly on a string
+    dimension, refused with the values on a numeric one (not a float conversion error)."""
+    from shipblock.errors import ParameterError
+    from shipblock.plot import sweep_selection
+
+    ds = xr.Dataset({"median": (("limit_state", "cap_material", "mu_top"), np.ones((1, 2, 2)))},
+                    coords={"limit_state": ["a"], "cap_material": ["white_oak", "teak_x"],
+                            "mu_top": [0.3, 0.5]})
+    assert sweep_selection(ds, {"cap_material": "teak_x", "mu_top": 0.5}) == {
+        "cap_material": "teak_x", "mu_top": 0.5}
+    with pytest.raises(ParameterError, match=r"mu_top = 'abc' is not a number; values: 0.3, "):
+        sweep_selection(ds, {"mu_top": "abc"})
+    with pytest.raises(ParameterError, match="'oak' is not a value of the study; values: "
+                                             "'white_oak', 'teak_x'"):
+        sweep_selection(ds, {"cap_material": "oak"})

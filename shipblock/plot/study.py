@@ -127,9 +127,14 @@ def sweep_selection(ds, sweep=None) -> dict:
             close = np.flatnonzero(values == str(sweep[dim]))
             shown = ", ".join(map(repr, values.tolist()))
         else:
-            close = np.flatnonzero(np.isclose(values.astype(float), float(sweep[dim]),
-                                              rtol=1e-9, atol=0.0))
             shown = ", ".join(f"{v:g}" for v in values)
+            try:
+                wanted = float(sweep[dim])
+            except (TypeError, ValueError):
+                raise ParameterError(f"{dim} = {sweep[dim]!r} is not a number; values: "
+                                     f"{shown}") from None
+            close = np.flatnonzero(np.isclose(values.astype(float), wanted, rtol=1e-9,
+                                              atol=0.0))
         if close.size != 1:
             raise ParameterError(f"{dim} = {sweep[dim]!r} is not a value of the study; values: "
                                  f"{shown}")
