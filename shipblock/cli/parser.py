@@ -54,7 +54,9 @@ def build_parser():
                        description="Simulate one record; prints a summary, writes NetCDF and a figure.")
     _add_record_arguments(s)
     g = s.add_argument_group("system (defaults: ShipBlockSystem.example())")
-    g.add_argument("--system", help="TOML file with a [system] table (SI units)")
+    g.add_argument("--system", help="TOML file with a [system] table (SI units, or quantities "
+                                    "with units); model = \"section\" runs the dock-section "
+                                    "model with the keys of a pipeline's [system]")
     for key, (flag, typ, help_) in SYSTEM_FLAGS.items():
         g.add_argument(flag, dest=key, type=typ, help=help_)
     g = s.add_argument_group("run")
@@ -65,7 +67,9 @@ def build_parser():
                         "392gal (the vertical by the same factor unless --vertical-scale)")
     g.add_argument("--vertical-scale", type=float, help="independent factor on the vertical")
     g.add_argument("--no-vertical", action="store_true", help="ignore the vertical component")
-    g.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance of rocking phases")
+    g.add_argument("--rtol", type=float,
+                   help="relative tolerance of the integration (default: 1e-8 for the rigid "
+                        "model's rocking phases, the section model's own otherwise)")
     g.add_argument("--output", "-o", help="NetCDF file for the response")
     g.add_argument("--figure", help="PNG for the response figure (default: next to --output)")
     g.add_argument("--events", type=int, default=20, help="list at most this many events")

@@ -11,14 +11,17 @@ from shipblock.cli.reading import _horizontal_line, _load_motion
 from shipblock.units import STANDARD_GRAVITY
 
 
-def _system_from_args(args):
-    """The system of --system and the system flags; quantities with units converted to SI
-    (shipblock.quantities), and a warning for a system outside any dock
-    (shipblock.system.warn_implausible)."""
+def _system_from_args(args, base=None):
+    """The system of --system (or ``base``, read from it already) and the system flags;
+    quantities with units converted to SI (shipblock.quantities), and a warning for a system
+    outside any dock (shipblock.system.warn_implausible)."""
     from shipblock.quantities import to_si
     from shipblock.system import FIELD_UNITS, ShipBlockSystem, warn_implausible
 
-    system = ShipBlockSystem.from_toml(args.system) if args.system else ShipBlockSystem.example()
+    if base is not None:
+        system = base
+    else:
+        system = ShipBlockSystem.from_toml(args.system) if args.system else ShipBlockSystem.example()
     changes = {k: getattr(args, k) for k in SYSTEM_FLAGS if getattr(args, k) is not None}
     changes = {k: to_si(v, FIELD_UNITS[k], SYSTEM_FLAGS[k][0]) if k in FIELD_UNITS else v
                for k, v in changes.items()}
@@ -54,19 +57,67 @@ def _scaled_input(args, motion):
             f"scaled to PGA {target / STANDARD_GRAVITY:.3g} g (factor {scaled.factor_h:.4g})")
 
 
+#: --rtol of a rigid-model run when not given (the section model has its own default).
+RIGID_RTOL = 1e-8
+
+
+def _model_system(args):
+    """``(model, system)`` of ``--system`` when its ``[system]`` names its model (``model =
+    "section"`` or ``"rigid"``: read as a pipeline's ``[system]``), else None (a plain
+    :meth:`~shipblock.system.ShipBlockSystem.from_toml` table).
+
+    The rigid model's flags (``--n-blocks``, ...) are refused for another model's system,
+    naming the flag; ``--ship-mass`` (a key of both) replaces its ``ship_mass``."""
+    from shipblock.checks import toml_file
+    from shipblock.fragility.schema import load_system
+    from shipblock.models import DEFAULT_MODEL
+
+    if not args.system:
+        return None
+    table = toml_file(args.system, "system file").get("system")
+    if not isinstance(table, dict) or "model" not in table:
+        return None
+    if table["model"] == DEFAULT_MODEL:  # the flags apply as to a plain table
+        return load_system(args.system)
+    given = [k for k in SYSTEM_FLAGS if getattr(args, k) is not None and k != "ship_mass"]
+    if given:
+        flag = SYSTEM_FLAGS[given[0]][0]
+        raise UserError(f"{flag} sets the rigid model's system; {args.system} is a "
+                        f"{table['model']!r} system: set its keys in the file")
+    model, system = load_system(args.system)
+    if args.ship_mass is not None:
+        system = model.vary(system, {"ship_mass": model.parameters["ship_mass"].check(
+            args.ship_mass)})
+    return model, system
+
+
 def cmd_simulate(args):
     from shipblock.plot import record_text
     from shipblock.solver import simulate
 
-    system = _system_from_args(args)
+    from shipblock.models import DEFAULT_MODEL
+
+    chosen = _model_system(args)
+    if chosen is None or chosen[0].name == DEFAULT_MODEL:
+        system = _system_from_args(args, None if chosen is None else chosen[1])
+        chosen = None
+    else:
+        system = chosen[1]
     motion = _load_motion(args)
     ax, ay, scale = _scaled_input(args, motion)
     log.info("simulating %d samples at dt = %g s", ax.size, motion.dt)
     sys.stdout.write(f"horizontal  {_horizontal_line(motion)}\n")
-    res = simulate(system, ax, ay, motion.dt, rtol=args.rtol)
     name = motion.name
     record = record_text(motion, scale)
-    _report(res, name, args.events)
+    if chosen is not None:
+        model = chosen[0]
+        options = {} if args.rtol is None else {"rtol": args.rtol}
+        res = model.simulate(system, ax, ay, motion.dt, **options)
+        _section_report(model, system, res, name, args.events)
+    else:
+        res = simulate(system, ax, ay, motion.dt,
+                       rtol=RIGID_RTOL if args.rtol is None else args.rtol)
+        _report(res, name, args.events)
     if args.output:
         ds = res.to_dataset()
         ds.attrs["record"] = str(name)
@@ -142,6 +193,54 @@ def _report(res, name, max_events):
     shown = [e for e in res.events[1:] if e.kind != "impact"][:max_events]
     for e in shown:
         out.write(f"  t = {e.time:10.5f} s  {e.kind:<18} mode {e.from_mode} -> {e.to_mode}\n")
+
+
+def _section_report(model, system, run, name, max_events):
+    """Print the summary of a dock-section run: record, dock, failure, the capacity and cap
+    pressure ratios per line, roll, sway, crushing, and its events."""
+    import numpy as np
+
+    out = sys.stdout
+    s = run.summary
+    h = run.ground[:, 0]
+    sec = system.section
+    failure = "none" if run.failure is None else f"{run.failure} at t = {run.failure_time:.4f} s"
+    rows = [("record", f"{name} ({h.size} samples, PGA_H = "
+                       f"{np.abs(h).max() / STANDARD_GRAVITY:.3f} g)"),
+            ("system", model.caption(system)),
+            ("failure", failure)]
+    for line, what in (("keel", "keel"), ("side0", "starboard side"), ("side1", "port side")):
+        if np.isfinite(s[f"{line}_capacity_ratio"]):
+            rows.append((f"{what} blocks", f"peak {s[f'{line}_peak_load_per_block'] / 1e3:.1f} "
+                         f"kN per block = {s[f'{line}_capacity_ratio']:.3f} of capacity; top cap "
+                         f"{s[f'{line}_peak_top_pressure_ratio']:.3f} of its proportional limit"))
+    rows += [
+        ("peak cap pressure", f"{s['cap_pressure_ratio']:.3f} of the proportional limit "
+                              f"(crushing set {1e3 * s['crushing_set']:.2f} mm)"),
+        ("peak / residual roll", f"{1e3 * s['peak_roll']:.4g} / {1e3 * s['residual_roll']:.4g} "
+                                 f"mrad ({np.degrees(s['peak_roll']):.3g} deg)"),
+        ("peak / residual sway", f"{1e3 * s['peak_sway']:.4g} / {1e3 * s['residual_sway']:.4g} "
+                                 f"mm on the keel blocks ({s['sway_ratio']:.3f} of the keel "
+                                 f"cap's half-width {1e3 * sec.keel.block.half_width:.0f} mm)"),
+        ("keel line slip", f"{1e3 * s['keel_slip']:.4g} mm on the floor"),
+        ("energy balance", f"residual {s['energy_residual']:.2e} (relative)"),
+    ]
+    width = max(len(r[0]) for r in rows)
+    for key, val in rows:
+        out.write(f"{key:<{width}}  {val}\n")
+    _events_report(run.events, max_events)
+
+
+def _events_report(events, max_events):
+    """Print the count of each kind of event and the first ``max_events`` (time, kind, where)."""
+    out = sys.stdout
+    counts = {}
+    for e in events:
+        counts[e.kind] = counts.get(e.kind, 0) + 1
+    out.write("events: " + (", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+                            or "none") + "\n")
+    for e in list(events)[:max_events]:
+        out.write(f"  t = {e.time:10.5f} s  {e.kind:<22} {getattr(e, 'where', '')}\n")
 
 
 def _response_figure(res, record):

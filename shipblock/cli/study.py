@@ -8,20 +8,28 @@ import sys
 from pathlib import Path
 
 from shipblock.cli._common import UserError, _save_figure
-from shipblock.cli.simulate import _report, _response_figure, _response_figure_option, _write_response
+from shipblock.cli.simulate import (
+    _events_report,
+    _report,
+    _response_figure,
+    _response_figure_option,
+    _write_response,
+)
 
 
 def _parse_assignments(items):
-    """``["mu_ground=0.4", ...]`` -> ``{"mu_ground": 0.4}`` (numbers only)."""
+    """``["mu_ground=0.4", "cap_material=white_oak"]`` -> ``{"mu_ground": 0.4, "cap_material":
+    "white_oak"}``: a number where the text is one, else the text (a name of a string
+    dimension, checked against the study's values where it is used)."""
     values = {}
     for item in items or []:
         name, sep, text = item.partition("=")
-        if not sep or not name.strip():
+        if not sep or not name.strip() or not text.strip():
             raise UserError(f"--set expects NAME=VALUE, got {item!r}")
         try:
             values[name.strip()] = float(text)
         except ValueError:
-            raise UserError(f"--set {name.strip()}: {text!r} is not a number") from None
+            values[name.strip()] = text.strip()
     return values
 
 
@@ -67,14 +75,7 @@ def _model_report(res, ds, max_events):
         elif isinstance(value, float):
             value = f"{value:.6g}"
         out.write(f"{name:<{width}}  {value} {'' if units in ('', '1') else units}\n")
-    events = list(getattr(res, "events", []))
-    counts = {}
-    for e in events:
-        counts[e.kind] = counts.get(e.kind, 0) + 1
-    out.write("events: " + (", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
-                            or "none") + "\n")
-    for e in events[:max_events]:
-        out.write(f"  t = {e.time:10.5f} s  {e.kind:<22} {getattr(e, 'where', '')}\n")
+    _events_report(getattr(res, "events", []), max_events)
 
 
 def cmd_run(args):

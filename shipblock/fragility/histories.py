@@ -79,6 +79,11 @@ def _record_index(design: AnalysisDesign, record) -> int:
 
 
 def _value_index(values, wanted, key: str, shown) -> int:
+    if len(values) and all(isinstance(v, str) for v in values):  # a string dimension: names
+        if wanted in values:
+            return list(values).index(wanted)
+        raise SelectionError(key, f"{wanted!r} is not a value of the design; values: "
+                                  f"{', '.join(map(repr, values))}")
     if isinstance(wanted, bool) or not isinstance(wanted, int | float | np.integer | np.floating):
         raise SelectionError(key, f"must be a number, got {wanted!r}")
     values = np.asarray(values, dtype=float)

@@ -79,7 +79,8 @@ from shipblock.fragility.limit_states import LimitState, parse_limit_states
 from shipblock.models import DEFAULT_MODEL, FieldError, Model, get_model
 from shipblock.units import STANDARD_GRAVITY, acceleration_to_si, velocity_to_si
 
-__all__ = ["HistoryRequest", "Pipeline", "PipelineError", "load_pipeline", "parse_pipeline"]
+__all__ = ["HistoryRequest", "Pipeline", "PipelineError", "load_pipeline", "load_system",
+           "parse_pipeline"]
 
 logger = logging.getLogger(__name__)
 
@@ -233,6 +234,23 @@ class Pipeline:
         return doc
 
 
+def load_system(path) -> tuple[Model, object]:
+    """``(model, system)`` of a file's ``[system]`` table, read as a pipeline's (its keys,
+    units and checks; ``model = "section"`` chooses the dock section), for a single run
+    (``shipblock simulate --system FILE``). Raises :class:`PipelineError` naming the file and
+    the key (``system.<key>``): unreadable, no ``[system]`` table, an invalid key or system."""
+    source = str(checks.pathname(path, "path", "a system TOML file"))
+    try:
+        table = checks.toml_file(source, "system file").get("system")
+    except ShipblockError as exc:
+        raise PipelineError("", str(exc), source) from None
+    if not isinstance(table, Mapping):
+        raise PipelineError("system", "missing: the file needs a [system] table", source)
+    model = _model(table, source)
+    check_table(table, "system", source, model)
+    return model, _system(table, model, source)
+
+
 def load_pipeline(path) -> Pipeline:
     """Read and validate a pipeline file.
 
@@ -326,7 +344,7 @@ def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:
     ids, catalogue, azimuth, horizontal, response = _records(doc["records"], base, source)
     chain = _processing(doc, source)
     system = _system(doc["system"], model, source)
-    sweep = _sweep(doc.get("sweep", {}), source)
+    sweep = _sweep(doc.get("sweep", {}), model, source)
     design, cloud_method = _design(doc["design"], ids, system, sweep, model, source)
     limit_states = _limit_states(doc["limit_states"], design, cloud_method, source)
     d = doc["design"]
@@ -473,14 +491,27 @@ def _system(table: Mapping, model: Model, source: str):
         raise PipelineError("system", str(exc), source) from None
 
 
-def _sweep(table: Mapping, source: str) -> tuple:
-    """``((name, values), ...)`` of ``[sweep]`` (names checked against the model's)."""
+def _sweep(table: Mapping, model: Model, source: str) -> tuple:
+    """``((name, values), ...)`` of ``[sweep]`` (names checked against the model's).
+
+    Numbers, or strings for a parameter the model declares as a string (a choice such as the
+    section model's ``cap_material``), each checked by that declaration.
+    """
     sweep = []
     for name, values in table.items():
         if not values:
             raise PipelineError(f"sweep.{name}", "must be a non-empty list of values", source)
+        declared = model.parameters.get(name)
         for v in values:
-            if isinstance(v, bool) or not isinstance(v, _NUM):
+            if declared is not None and str in declared.types:
+                if not isinstance(v, str):
+                    raise PipelineError(f"sweep.{name}", f"must hold strings, got {v!r}",
+                                        source)
+                try:
+                    declared.check(v)
+                except FieldError as exc:
+                    raise PipelineError(f"sweep.{name}", exc.problem, source) from None
+            elif isinstance(v, bool) or not isinstance(v, _NUM):
                 raise PipelineError(f"sweep.{name}", f"must hold numbers, got {v!r}", source)
         if len(set(values)) != len(values):
             raise PipelineError(f"sweep.{name}", f"sweep {name!r} repeats a value", source)

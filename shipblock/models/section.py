@@ -33,15 +33,17 @@ section's own constructors with the ``[system]`` key named (:meth:`SectionModel.
 * the blocks (every line; defaults the US Navy keel block of
   :data:`~shipblock.section.NAVY_BLOCK`): ``block_half_width``, ``block_half_height``,
   ``block_length``, ``block_mass`` (default: concrete core and oak caps), ``block_capacity``;
-* the caps (top and bottom alike; defaults white oak): ``cap_thickness``, ``cap_modulus``,
-  ``cap_proportional_limit``, ``cap_stiffness`` (default ``E A / t``), ``cap_damping_ratio``,
-  ``cap_shear_ratio``;
+* the caps (top and bottom alike; defaults white oak): ``cap_thickness``, ``cap_material``
+  (a timber of :data:`~shipblock.section.parameters.CAP_MATERIALS`, which gives the modulus
+  and the proportional limit) or ``cap_modulus`` and ``cap_proportional_limit`` (not both),
+  ``cap_stiffness`` (default ``E A / t``), ``cap_damping_ratio``, ``cap_shear_ratio``;
 * friction: ``mu_s_top``, ``mu_k_top`` (hull on the top caps), ``mu_s_bottom``,
   ``mu_k_bottom`` (blocks on the floor);
 * wind: ``wind_force``, or ``wind_pressure`` and ``wind_area``; ``wind_height``;
 * ``n_springs`` (springs across a cap) and ``g``.
 
-Swept parameters are every numeric key and two conveniences, ``mu_top`` and ``mu_bottom``:
+Swept parameters are every numeric key, ``cap_material`` (a list of names: a string
+dimension of the study) and two conveniences, ``mu_top`` and ``mu_bottom``:
 the static friction coefficient of a face, the kinetic one keeping its ratio to the static one
 in the base system (as the rigid model's ``mu_ship``).
 
@@ -74,6 +76,8 @@ from shipblock.models.base import EDPInfo, Field, FieldError, Model
 from shipblock.section import NAVY_BLOCK, Block, BlockLine, Cap, DockSection, Ship, Wind
 from shipblock.section.model import assemble, static_state
 from shipblock.section.parameters import (
+    CAP_MATERIALS,
+    DEFAULT_CAP_MATERIAL,
     MAX_BLOCKS,
     MAX_HULL_SLOPE,
     MAX_SIDE_LINES,
@@ -176,11 +180,16 @@ PARAMETERS: Mapping[str, Field] = MappingProxyType({f.name: f for f in (
     # the caps
     _limited("cap_thickness", Cap.LIMITS, "thickness", "thickness of a cap (top and bottom)",
              "m", "m", default=_CAP.thickness),
-    _limited("cap_modulus", Cap.LIMITS, "modulus", "modulus of the caps across the grain",
-             "Pa", "Pa", default=_CAP.modulus),
+    Field("cap_material", (str,), "timber of the caps (Wood Handbook 2010 values: "
+          "cap_modulus and cap_proportional_limit)", default=DEFAULT_CAP_MATERIAL,
+          choices=tuple(CAP_MATERIALS)),
+    _limited("cap_modulus", Cap.LIMITS, "modulus", "modulus of the caps across the grain "
+             "(instead of cap_material's)", "Pa", "Pa",
+             default_doc=f"cap_material's ({_CAP.modulus:.4g} Pa for white oak)"),
     _limited("cap_proportional_limit", Cap.LIMITS, "proportional_limit", "compression "
-             "perpendicular to the grain at the proportional limit (crushing beyond)", "Pa",
-             "Pa", default=_CAP.proportional_limit),
+             "perpendicular to the grain at the proportional limit, crushing beyond (instead "
+             "of cap_material's)", "Pa", "Pa",
+             default_doc=f"cap_material's ({_CAP.proportional_limit:.4g} Pa for white oak)"),
     _limited("cap_stiffness", Cap.LIMITS, "stiffness", "normal stiffness of one block's cap",
              "N/m", "N/m", default_doc="cap_modulus x area / cap_thickness"),
     _limited("cap_damping_ratio", Cap.LIMITS, "damping_ratio", "viscous damping ratio of a "
@@ -391,7 +400,15 @@ def _section(v: Mapping[str, Any]) -> DockSection:
             raise FieldError("wind_force", "give wind_force, or wind_pressure and wind_area "
                                            "together (not both, not neither)")
         wind = Wind(p["wind_height"], p["wind_force"], p["wind_pressure"], p["wind_area"])
-    caps = {kind: Cap(p["cap_thickness"], p["cap_modulus"], p["cap_proportional_limit"],
+    material = CAP_MATERIALS[p["cap_material"]]
+    for key in ("cap_modulus", "cap_proportional_limit"):
+        if "cap_material" in v and v.get(key) is not None:
+            raise FieldError(key, f"and cap_material ({p['cap_material']!r}) both set the "
+                                  "caps' timber; give one")
+    modulus = material.modulus if p["cap_modulus"] is None else p["cap_modulus"]
+    limit = (material.proportional_limit if p["cap_proportional_limit"] is None
+             else p["cap_proportional_limit"])
+    caps = {kind: Cap(p["cap_thickness"], modulus, limit,
                       p["cap_stiffness"], p["cap_damping_ratio"], p[f"mu_s_{kind}"],
                       p[f"mu_k_{kind}"], p["cap_shear_ratio"]) for kind in ("top", "bottom")}
     block = Block(p["block_half_width"], p["block_half_height"], p["block_length"],
@@ -632,7 +649,11 @@ class SectionModel(Model):
                      f"{line.n_blocks} at {abs(line.offset):.3g} m"
                      f"{'' if line.moving else ' (fixed)'}")
         cap = b.top
-        return (text + f"; caps {cap.thickness * 1e3:.3g} mm, E {cap.modulus / 1e9:.3g} GPa; "
+        given = system.values
+        timber = ("" if "cap_modulus" in given or "cap_proportional_limit" in given
+                  else f"{given.get('cap_material', DEFAULT_CAP_MATERIAL)}, ")
+        return (text + f"; caps {cap.thickness * 1e3:.3g} mm, {timber}E {cap.modulus / 1e9:.3g}"
+                f" GPa; "
                 f"friction top {cap.mu_s:.3g}/{cap.mu_k:.3g}, floor {b.bottom.mu_s:.3g}/"
                 f"{b.bottom.mu_k:.3g} (static/kinetic)")
 

@@ -28,23 +28,23 @@ def _new_axes(nrows, sharex=True, height=1.8):
 #: title's).
 SUPTITLE_WIDTH = 140
 
-#: Longest title line of a study figure [characters]: about the width of the default figure
-#: at the title's font size.
-TITLE_WIDTH = 140
+#: Longest title line of a study figure [characters]: the width of the default figure's axes
+#: at the title's font size (140 ran past the right edge of a fragility figure).
+TITLE_WIDTH = 118
 
 
 def _title(ax, caption, what):
     """Title of a study figure: the caption lines (:func:`study_caption`), then what it shows,
-    each wrapped to :data:`TITLE_WIDTH`."""
-    lines = [w for line in [*caption, *what] for w in textwrap.wrap(line, TITLE_WIDTH)]
-    ax.set_title("\n".join(lines), fontsize=8.5, loc="left")
+    each wrapped to :data:`TITLE_WIDTH` at spaces only (never inside "blocks-floor")."""
+    ax.set_title(wrapped([*caption, *what], TITLE_WIDTH), fontsize=8.5, loc="left")
 
 
 
 
 def wrapped(lines, width) -> str:
     """``lines`` joined by newlines, each wrapped to ``width`` characters."""
-    return "\n".join(w for line in lines for w in textwrap.wrap(line, width))
+    return "\n".join(w for line in lines
+                     for w in textwrap.wrap(line, width, break_on_hyphens=False))
 
 
 def system_text(system) -> str:

@@ -96,7 +96,8 @@ def sweep_selection(ds, sweep=None) -> dict:
     ds : xarray.Dataset
         A result of :func:`shipblock.run_pipeline`.
     sweep : dict, optional
-        Swept parameter -> value; a value is matched to the study's within 1e-9 relative.
+        Swept parameter -> value; a number is matched to the study's within 1e-9 relative, a
+        name (a string dimension such as ``cap_material``) exactly.
 
     Returns
     -------
@@ -122,11 +123,21 @@ def sweep_selection(ds, sweep=None) -> dict:
         if dim not in sweep:
             out[dim] = values[0]
             continue
-        close = np.flatnonzero(np.isclose(values.astype(float), float(sweep[dim]), rtol=1e-9,
-                                          atol=0.0))
+        if values.dtype.kind in "US":  # a string dimension (a choice): the name itself
+            close = np.flatnonzero(values == str(sweep[dim]))
+            shown = ", ".join(map(repr, values.tolist()))
+        else:
+            shown = ", ".join(f"{v:g}" for v in values)
+            try:
+                wanted = float(sweep[dim])
+            except (TypeError, ValueError):
+                raise ParameterError(f"{dim} = {sweep[dim]!r} is not a number; values: "
+                                     f"{shown}") from None
+            close = np.flatnonzero(np.isclose(values.astype(float), wanted, rtol=1e-9,
+                                              atol=0.0))
         if close.size != 1:
             raise ParameterError(f"{dim} = {sweep[dim]!r} is not a value of the study; values: "
-                                 f"{', '.join(f'{v:g}' for v in values)}")
+                                 f"{shown}")
         out[dim] = values[close[0]]
     return out
 
@@ -319,7 +330,10 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
     that equal medians and their bars stay visible: the swept values are a few known settings
     (the ticks), not a measured abscissa, so the offset misplaces nothing, and the title says
     it. The legend names the values where a fit failed; the title the study, system and design
-    (:func:`study_caption`; the system with the other swept values drawn).
+    (:func:`study_caption`; the system with the other swept values drawn). A string dimension
+    (names, such as the section model's ``cap_material``) is drawn at one tick per name, its
+    medians unjoined; the bars run from the band's lower to its upper bound (a bootstrap band
+    need not contain the fitted median).
 
     Parameters
     ----------
@@ -356,7 +370,10 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
     names = list(ds["limit_state"].values)
     if limit_state is not None:
         names = [limit_state] if isinstance(limit_state, str) else list(limit_state)
-    x = ds[parameter].values.astype(float)
+    values = ds[parameter].values
+    # a string dimension (a choice such as cap_material): one position per name, named ticks
+    categorical = values.dtype.kind in "US"
+    x = np.arange(values.size, dtype=float) if categorical else values.astype(float)
     span = float(np.ptp(x)) or 1.0
     _, ylabel, factor = _im_axis(ds, [])
     bars_drawn = False
@@ -366,20 +383,29 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
         xd = x + DODGE * span * (i - (len(names) - 1) / 2)
         med = ds["median"].sel(limit_state=name).sel(others).values / factor
         label = f"{name} ({limit_state_text(ds, name)})"
-        missing = [f"{v:g}" for v, m in zip(x, med, strict=True) if not np.isfinite(m)]
+        missing = [str(v) if categorical else f"{v:g}"
+                   for v, m in zip(values, med, strict=True) if not np.isfinite(m)]
         if missing:
             label += f"; not fitted at {parameter} = {', '.join(missing)}"
-        ax.plot(xd, med, "-" + _MARKERS[i % len(_MARKERS)], color=c, lw=1.5, ms=5,
+        # names have no order between them: no line joins their medians
+        ax.plot(xd, med, ("" if categorical else "-") + _MARKERS[i % len(_MARKERS)], color=c,
+                lw=1.5, ms=5,
                 mfc="white", mew=1.5, label=label)
         if "median_lower" in ds:
             lo = ds["median_lower"].sel(limit_state=name).sel(others).values / factor
             hi = ds["median_upper"].sel(limit_state=name).sel(others).values / factor
             bars_drawn = bars_drawn or bool(np.isfinite(lo).any() and np.isfinite(hi).any())
-            ax.errorbar(xd, med, yerr=[med - lo, hi - med], fmt="none", ecolor=c, elinewidth=1,
-                        capsize=3)
+            # bars from bound to bound: a bootstrap band need not contain the fitted median
+            # (a skewed or few-record bootstrap), which errorbar's yerr cannot draw
+            ax.vlines(xd, lo, hi, colors=c, lw=1)
+            ax.plot(np.r_[xd, xd], np.r_[lo, hi], "_", color=c, ms=6)
+    if categorical:
+        ax.set_xticks(x, [str(v) for v in values], fontsize=7.5)
+        ax.set_xlim(-0.5, values.size - 0.5)
     units = ds[parameter].attrs.get("units", "")
     long_name = ds[parameter].attrs.get("long_name", "").replace("swept parameter: ", "")
-    ax.set_xlabel(f"{parameter} [{units if units not in ('', '1') else '-'}]"
+    ax.set_xlabel(f"{parameter}" + ("" if categorical else
+                                    f" [{units if units not in ('', '1') else '-'}]")
                   + (f": {long_name}" if long_name else ""))
     ax.set_ylabel(f"median {ylabel}")
     ax.grid(True, lw=0.3, alpha=0.5)
@@ -389,8 +415,8 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
         what += "; bars: " + (f"{100 * float(conf):g} % " if conf is not None else "") \
             + "bootstrap band"
     if len(names) > 1:
-        what += (f"; limit states side by side, {100 * DODGE:g} % of the {parameter} range "
-                 "apart")
+        what += (f"; limit states side by side, {100 * DODGE:g} % of the "
+                 + ("span of the names" if categorical else f"{parameter} range") + " apart")
     if others:
         what += f"; drawn at {sweep_text(others)}"
     # the system line holds the base value of the parameter on the x axis: say it is swept

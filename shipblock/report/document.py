@@ -164,7 +164,8 @@ def _wrapped(lines, figure_width: float = _STUDY_FIGURE_WIDTH) -> str:
     """A figure title: ``lines`` wrapped to the study figures' width (:data:`TITLE_WIDTH`
     characters on a figure of theirs), shortened in proportion on a narrower figure."""
     width = int(TITLE_WIDTH * min(1.0, figure_width / _STUDY_FIGURE_WIDTH))
-    return "\n".join(w for line in lines for w in textwrap.wrap(line, width))
+    return "\n".join(w for line in lines
+                     for w in textwrap.wrap(line, width, break_on_hyphens=False))
 
 
 def _pipeline_document(ds) -> dict:

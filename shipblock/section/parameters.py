@@ -31,17 +31,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 from shipblock.checks import flag, real, whole
 from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.units import INCH, LONG_TON_FORCE, STANDARD_GRAVITY
 
 __all__ = [
+    "CAP_MATERIALS",
     "LONG_TON_FORCE",
     "NAVY_BLOCK",
     "Block",
     "BlockLine",
     "Cap",
+    "CapMaterial",
     "DockSection",
     "Ship",
     "Wind",
@@ -65,6 +68,65 @@ SHEAR_FREE_FACTOR = 1.10
 WHITE_OAK_ET_OVER_EL = 0.072
 #: Modulus of white oak across the grain, tangential direction [Pa]: 0.072 * 1.10 * 12.3 GPa.
 WHITE_OAK_MODULUS_T = WHITE_OAK_ET_OVER_EL * SHEAR_FREE_FACTOR * WHITE_OAK_BENDING_MODULUS
+@dataclass(frozen=True)
+class CapMaterial:
+    r"""A cap timber: its modulus across the grain and its proportional limit in compression.
+
+    Parameters
+    ----------
+    name : str
+        The name a ``[system] cap_material`` key gives.
+    bending_modulus : float
+        Static-bending modulus of elasticity of clear wood [Pa] (Wood Handbook 2010, Table 5-3a).
+    proportional_limit : float
+        Compression perpendicular to the grain, fibre stress at the proportional limit [Pa]
+        (same table).
+    et_over_el : float
+        Elastic ratio E_T / E_L (Table 5-1, given there at about 12 % moisture content only).
+    source : str
+        Where the numbers were read.
+
+    Notes
+    -----
+    The modulus across the grain of a flat-sawn cap (loaded tangentially) is
+    :math:`E_T = (E_T/E_L)\,1.10\,E_{bend}`, the 1.10 removing the shear deflection from the
+    bending modulus (Table 5-3's footnote).
+    """
+
+    name: str
+    bending_modulus: float
+    proportional_limit: float
+    et_over_el: float
+    source: str
+
+    @property
+    def modulus(self) -> float:
+        """Modulus across the grain, tangential direction E_T [Pa]."""
+        return self.et_over_el * SHEAR_FREE_FACTOR * self.bending_modulus
+
+
+_HANDBOOK = "USDA FPL Wood Handbook 2010 (FPL-GTR-190), Table 5-3a"
+_ENGDATABASE = ("as reproduced by engdatabase.com (wood properties from the Wood Handbook), "
+                "not read in the Handbook itself")
+
+#: Cap timbers a ``[system] cap_material`` names; clear wood, Wood Handbook 2010. The green
+#: (soaked) rows keep the 12 % elastic ratio: Table 5-1 gives none for green wood. Each number
+#: and where it was read: ``docs/theory/section.md``, table "Cap materials".
+CAP_MATERIALS = MappingProxyType({m.name: m for m in (
+    CapMaterial("white_oak", WHITE_OAK_BENDING_MODULUS, WHITE_OAK_PROPORTIONAL_LIMIT,
+                WHITE_OAK_ET_OVER_EL, f"{_HANDBOOK}, 12 % MC; Table 5-1 (E_T/E_L 0.072)"),
+    CapMaterial("white_oak_green", 8.6e9, 4.6e6, WHITE_OAK_ET_OVER_EL,
+                f"{_HANDBOOK}, green; E_T/E_L of Table 5-1 at 12 % MC"),
+    CapMaterial("douglas_fir_interior_south", 10.3e9, 5.1e6, 0.050,
+                f"{_HANDBOOK}, Douglas-fir, Interior South, 12 % MC; Table 5-1 (E_T/E_L "
+                f"0.050); {_ENGDATABASE}"),
+    CapMaterial("douglas_fir_interior_south_green", 8.0e9, 2.3e6, 0.050,
+                f"{_HANDBOOK}, Douglas-fir, Interior South, green; E_T/E_L of Table 5-1 at "
+                f"12 % MC; {_ENGDATABASE}"),
+)})
+#: The material of the default caps.
+DEFAULT_CAP_MATERIAL = "white_oak"
+
 #: Steepest hull slope a block top can be cut to [rad]: beyond 45 deg the normal force on the cap
 #: pushes the block sideways harder than down (a shore, not a block).
 MAX_HULL_SLOPE = math.radians(45.0)

@@ -1,0 +1,108 @@
+"""``shipblock simulate --system FILE`` with ``[system] model = "section"``: one record on the
+dock section, through :func:`shipblock.cli.main`.
+
+Checks: at a static-like motion (the record scaled by 1e-5) the printed and stored keel-block
+load is the weight per block, W / n, and its ratio to the rated capacity; ``--ship-mass``
+replaces the file's mass (the load doubles with it); the histories are written as NetCDF
+(``SectionRun.to_dataset``) and the response figure drawn; the rigid model's flags and a bad
+key are refused by name.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from shipblock.cli import main
+from shipblock.section import NAVY_BLOCK
+from shipblock.units import STANDARD_GRAVITY as G
+
+from .test_batch import make_catalogue
+from .test_section_study import SYSTEM  # a 30 t ship on two narrow Navy keel blocks
+
+
+@pytest.fixture(scope="module")
+def records(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("records")
+    return make_catalogue(folder, n_records=1)
+
+
+def _simulate(tmp_path, records, *extra, system=SYSTEM):
+    path = tmp_path / "dock.toml"
+    path.write_text(system)
+    return main(["simulate", "--catalogue", str(records), "--record", "S0", "--horizontal", "H1",
+                 "--system", str(path), *extra])
+
+
+def test_a_section_system_runs_the_section_model(tmp_path, records, capsys):
+    out = tmp_path / "run.nc"
+    assert _simulate(tmp_path, records, "--scale", "1e-5", "-o", str(out)) == 0
+    text = capsys.readouterr().out
+    load = 30e3 * G / 2  # the ship's weight on two keel blocks, at rest
+    ratio = load / NAVY_BLOCK.capacity
+    assert "failure  " in text and "none" in text.split("failure", 1)[1].splitlines()[0]
+    assert f"peak {load / 1e3:.1f} kN per block = {ratio:.3f} of capacity" in text
+    assert "peak / residual roll" in text and "events:" in text
+    assert "side blocks" not in text  # no side lines
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["model"] == "section"
+        assert ds.attrs["keel_capacity_ratio"] == pytest.approx(ratio, rel=1e-6)
+        assert ds.attrs["failure_name"] == "none"
+        for name in ("ship_sway", "ship_roll", "ground_acceleration_h"):
+            assert name in ds and ds[name].dims == ("time",)
+        # the ground the run was given: the record scaled by 1e-5, peak about 1e-5 m/s^2
+        assert 0 < np.abs(ds["ground_acceleration_h"]).max() < 1e-4
+    assert out.with_suffix(".png").stat().st_size > 0
+
+
+def test_ship_mass_replaces_the_files_mass(tmp_path, records, capsys):
+    assert _simulate(tmp_path, records, "--scale", "1e-5", "--ship-mass", "60 t",
+                     "--figure", str(tmp_path / "r.png")) == 0
+    text = capsys.readouterr().out
+    load = 60e3 * G / 2
+    assert f"peak {load / 1e3:.1f} kN per block = {load / NAVY_BLOCK.capacity:.3f}" in text
+    assert "ship 60 t" in text
+    assert (tmp_path / "r.png").stat().st_size > 0
+
+
+def test_a_real_motion_loads_the_blocks_beyond_their_static_share(tmp_path, records, capsys):
+    """At the record's own strength (peak about 1 m/s^2) the ship rocks on its two blocks:
+    the peak load per block exceeds the static W / n, never by more than the whole weight."""
+    out = tmp_path / "strong.nc"
+    assert _simulate(tmp_path, records, "-o", str(out)) == 0
+    capsys.readouterr()
+    with xr.open_dataset(out) as ds:
+        peak = ds.attrs["keel_peak_load_per_block"]
+        assert 30e3 * G / 2 < peak < 30e3 * G * 1.5
+        assert abs(ds.attrs["energy_residual"]) < 1e-3
+
+
+@pytest.mark.parametrize("extra, needle", [
+    (("--n-blocks", "4"), "--n-blocks sets the rigid model's system"),
+    (("--mu-s-ship", "0.3"), "--mu-s-ship sets the rigid model's system"),
+])
+def test_rigid_flags_are_refused_for_a_section_system(tmp_path, records, capsys, extra,
+                                                       needle):
+    assert _simulate(tmp_path, records, *extra) != 0
+    assert needle in capsys.readouterr().err
+
+
+def test_a_bad_key_of_the_section_system_is_named(tmp_path, records, capsys):
+    assert _simulate(tmp_path, records, system=SYSTEM + "keel_block = 3\n") != 0
+    err = capsys.readouterr().err
+    assert "dock.toml" in err and "keel_block" in err
+    assert _simulate(tmp_path, records, system=SYSTEM.replace('"30 t"', '"30 m"')) != 0
+    err = capsys.readouterr().err
+    assert "[system.ship_mass]" in err
+
+
+def test_a_pipelines_rigid_system_table_runs_the_rigid_model(tmp_path, records, capsys):
+    """``model = "rigid"`` (a rigid pipeline's ``[system]``): the rigid model, with the system
+    flags applied to it."""
+    rigid = ('[system]\nmodel = "rigid"\nship_mass = "5000 t"\nblock_mass = "1.2 t"\n'
+             'n_blocks = 150\nhalf_width = 0.3\nhalf_height = 0.6\nmu_s_ground = 0.6\n'
+             'mu_k_ground = 0.55\nmu_s_ship = 0.35\nmu_k_ship = 0.3\n')
+    assert _simulate(tmp_path, records, "--n-blocks", "100", system=rigid) == 0
+    text = capsys.readouterr().out
+    assert "M = 5e+06 kg on 100 blocks of 1200 kg" in text and "peak ship slip" in text
