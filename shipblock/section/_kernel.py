@@ -101,13 +101,43 @@ def kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
             vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
             vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
             delta_dot[i] = (vsy - vcy) * ny + (vsz - vcz) * nz
-        ry, rz = strip_f[j, SF_CY], strip_f[j, SF_CZ]
-        py = cy + cc * ry - cs * rz
-        pz = cz + cs * ry + cc * rz
-        vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
-        vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
-        # tangent t = (n_z, -n_y): (1, 0) on the floor
-        vt[j] = (vcy - vsy) * nz - (vcz - vsz) * ny
+        vt[j] = _tangential_rate(x, nb, strip_f, strip_i, j, strip_f[j, SF_CY], strip_f[j, SF_CZ])
+
+
+@njit(cache=True, inline="always")
+def _tangential_rate(x, nb, strip_f, strip_i, j, ry, rz):
+    """Relative tangential velocity, along S's tangent ``t = (n_z, -n_y)``, of C's material point
+    ``(ry, rz)`` (in C's frame) over S's material point at the same place."""
+    cb, sb = strip_i[j, SI_C], strip_i[j, SI_S]
+    cy, cz, ca = _pose(x, cb, strip_f[j, SF_PY], strip_f[j, SF_PZ], strip_f[j, SF_PA])
+    sy, sz, sa = _pose(x, sb, 0.0, 0.0, 0.0)
+    cvy, cvz, cw = _vel(x, nb, cb)
+    svy, svz, sw = _vel(x, nb, sb)
+    cc, cs = math.cos(ca), math.sin(ca)
+    sc, ss = math.cos(sa), math.sin(sa)
+    ny = sc * strip_f[j, SF_SNY] - ss * strip_f[j, SF_SNZ]
+    nz = ss * strip_f[j, SF_SNY] + sc * strip_f[j, SF_SNZ]
+    py = cy + cc * ry - cs * rz
+    pz = cz + cs * ry + cc * rz
+    vsy, vsz = svy - sw * (pz - sz), svz + sw * (py - sy)
+    vcy, vcz = cvy - cw * (pz - cz), cvz + cw * (py - cy)
+    return (vcy - vsy) * nz - (vcz - vsz) * ny
+
+
+@njit(cache=True, inline="always")
+def friction_point(strip_f, strip_i, spring_f, fn, j):
+    """Where strip j's friction acts and its slip is measured, in C's frame: the centre of
+    pressure of its spring forces ``fn`` (a rocking block's corner, as in the rigid model's
+    sticking pivot), or the face centre while it carries nothing."""
+    w, ry, rz = 0.0, 0.0, 0.0
+    for i in range(strip_i[j, SI_FIRST], strip_i[j, SI_FIRST] + strip_i[j, SI_COUNT]):
+        if fn[i] > 0.0:
+            w += fn[i]
+            ry += fn[i] * spring_f[i, PF_RY]
+            rz += fn[i] * spring_f[i, PF_RZ]
+    if w > 0.0:
+        return ry / w, rz / w
+    return strip_f[j, SF_CY], strip_f[j, SF_CZ]
 
 
 @njit(cache=True, inline="always")
@@ -138,6 +168,10 @@ def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, d
                 fn[i] = 0.0
             total += fn[i]
         normal[j] = total
+        if total > 0.0:
+            # slip rate at the centre of pressure (where the friction acts, see rhs)
+            ry, rz = friction_point(strip_f, strip_i, spring_f, fn, j)
+            vt[j] = _tangential_rate(x, nb, strip_f, strip_i, j, ry, rz)
         if fs[j] == F_STICK:
             tang[j] = -strip_f[j, SF_KT] * x[o_u + j] - strip_f[j, SF_CT] * vt[j]
         elif fs[j] == F_FREE:
@@ -205,7 +239,7 @@ def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, op
             d_fric += -ft * vt[j]
         if ft != 0.0:
             cc, cs = math.cos(ca), math.sin(ca)
-            ry, rz = strip_f[j, SF_CY], strip_f[j, SF_CZ]
+            ry, rz = friction_point(strip_f, strip_i, spring_f, fn, j)
             py = cy + cc * ry - cs * rz
             pz = cz + cs * ry + cc * rz
             fy_, fz_ = ft * nz, -ft * ny  # along t = (n_z, -n_y)
