@@ -72,7 +72,8 @@ def free_rocking(k, damping, ship_mass=LIGHT_SHIP, omega0=0.4, duration=1.5, dt=
 def forced_rocking(k, damping, duration=3.0, dt=0.002, proportional_limit=1e10):
     """Rocking with a 200 t ship on top under a 1.5 Hz, 0.5 g sine: the largest difference of
     |theta| from the rigid solver with the plastic impact rule [rad], the rigid peak rotation
-    and its impact count, and the number of times a keel_top spring detaches. The caps do not
+    and its impact count, the number of times a keel_top spring detaches and the error of the
+    peak rotation [rad]. The caps do not
     crush (``proportional_limit`` 10 GPa): with oak's 7.4 MPa the impact forces of caps stiffer
     than 1e11 N/m crush them at every impact, a loss the rigid model does not have."""
     t = np.arange(0.0, duration, dt)
@@ -88,7 +89,8 @@ def forced_rocking(k, damping, duration=3.0, dt=0.002, proportional_limit=1e10):
     impacts = sum(e.kind == "impact" for e in ref.events)
     detach = sum(e.kind == "spring_detaches" and e.where.startswith("keel_top")
                  for e in res.events)
-    return diff, ref.summary["peak_rotation"], impacts, detach
+    peak_error = abs(res.summary["keel_peak_rotation"] - ref.summary["peak_rotation"])
+    return diff, ref.summary["peak_rotation"], impacts, detach, peak_error
 
 
 def test_housner_block_on_stiff_two_spring_base_converges_at_first_order():
@@ -134,11 +136,29 @@ def test_heavy_ship_first_impact_is_the_rigid_systems_plastic_impact():
     assert errors[1] < errors[0] / 10 and errors[1] < 1e-3
 
 
-def test_rocking_with_a_ship_on_top_levels_off_near_the_plastic_rigid_model():
-    """Under a sine with a 200 t ship on top and eight rigid impacts, the compliant model stays
-    within 2.5 % of the rigid peak rotation of the plastic rule, but stiffer caps do not bring
-    it closer (docs/theory/section.md, 'Rocking impacts')."""
+def test_forced_rocking_with_a_ship_on_top_converges_to_the_plastic_rigid_model():
+    """Under a sine with a 200 t ship on top and eight rigid impacts, the peak rotation agrees
+    with the plastic rigid rule to 1e-3 of itself and the history difference falls with the
+    stiffness. (Before the friction was measured at the centre of pressure it levelled off at
+    1 % of the peak: docs/theory/section.md, 'Rocking impacts'.)"""
     out = [forced_rocking(k, damping=5.0) for k in (1e10, 1e11)]
-    for diff, peak, impacts, detach in out:
+    for _, peak, impacts, detach, peak_error in out:
         assert impacts >= 6 and detach >= impacts
-        assert diff < 0.025 * peak
+        assert peak_error < 1e-3 * peak
+    (diff10, peak, *_), (diff11, *_) = out
+    assert diff11 < diff10 / 3 and diff11 < 4e-3 * peak
+
+
+def test_rocking_pivot_corner_sticks_in_the_rigid_limit():
+    """The friction of a strip acts, and its slip is measured, at the centre of pressure: a
+    block rocking on its corner keeps that corner in place, as the rigid model's sticking
+    pivot (when it was measured at the face centre the corner slid by B (1 - cos theta),
+    1.3 mm at 0.09 rad: a different constraint, whatever the stiffness)."""
+    _, _, res = free_rocking(1e11, damping=5.0, ship_mass=2e5, omega0=0.5, duration=0.5)
+    y, _, theta = res.lines["keel"].T
+    i = int(np.argmax(np.abs(theta)))
+    assert theta[i] > 0.05 and np.all(theta[1:i + 1] > 0.0)  # rocking on the corner at -B
+    # horizontal position of the pivot corner (-B, -H) of the line's centre, from rest; the
+    # first millisecond (the stick springs taking up the start) left out
+    corner = y - HALF_WIDTH * np.cos(theta) + HALF_HEIGHT * np.sin(theta) + HALF_WIDTH
+    assert abs(corner[i] - corner[1]) < 0.01 * HALF_WIDTH * (1 - np.cos(theta[i]))
