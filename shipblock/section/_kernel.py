@@ -321,10 +321,16 @@ def event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs
     phi = x[2]
     gv[o + 1] = opt[O_TIP_POS] - phi if phi >= 0.0 else opt[O_TIP_NEG] + phi
     gv[o + 2] = opt[O_SEP] - min_gap
-    # validity: displacements and rotations within what the model is written for
+    # validity: displacements (from the body's place as built: G's offset for the ship, the
+    # line's offset for a block line) and rotations within what the model is written for
     worst = 0.0
     for b in range(nb):
-        worst = max(worst, abs(x[3 * b]) / opt[O_MAX_DISP])
+        ref = -strip_f[0, SF_SQY]  # strip 0 is the keel top, its surface point -g_offset on S
+        if b > 0:
+            for j in range(strip_i.shape[0]):
+                if strip_i[j, SI_C] == b:
+                    ref = strip_f[j, SF_PY]
+        worst = max(worst, abs(x[3 * b] - ref) / opt[O_MAX_DISP])
         worst = max(worst, abs(x[3 * b + 2]) / opt[O_MAX_ANGLE])
     gv[o + 3] = 1.0 - worst
 
