@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from shipblock.section import Block, BlockLine, Cap, DockSection, Ship
+from shipblock.section import NAVY_BLOCK, Block, BlockLine, Cap, DockSection, Ship
 from shipblock.section.model import MAX_DISPLACEMENT
 from shipblock.section.simulate import simulate_section
 
@@ -63,3 +63,21 @@ def test_floor_falling_faster_than_gravity_stops_as_separation():
     assert abs(res.energy["residual"]) < 1e-6
     # the stack has left the floor: every spring open at the end
     assert all(n[-1] == 0.0 for n in res.normal.values())
+
+
+def test_side_lines_beyond_ten_metres_from_the_centre_line_are_valid():
+    """The 10 m limit is on a body's displacement from where it was built, not on its distance
+    from the centre line: a wide ship on moving side lines at +-12 m (a real docking plan) runs
+    (it stopped at t = 0 as out_of_validity before)."""
+    ship = Ship(mass=2e6, roll_inertia=2e6 * 100.0, g_height=6.0, keel_half_width=0.8,
+                half_beam=16.0)
+    side = Block(half_height=NAVY_BLOCK.half_height + 0.15)
+    sides = tuple(BlockLine(block=side, n_blocks=2, offset=s * 12.0, hull_height=0.3)
+                  for s in (-1, 1))
+    dock = DockSection(ship, BlockLine(n_blocks=6), sides)
+    dt = 0.005
+    t = np.arange(0.0, 1.0, dt)
+    res = simulate_section(dock, 0.1 * 9.80665 * np.sin(2 * np.pi * t), None, dt)
+    assert res.failure is None and res.time[-1] == pytest.approx(t[-1])
+    assert res.summary["side0_peak_slip"] < 1e-2
+    assert abs(res.energy["residual"]) < 1e-6
