@@ -37,16 +37,18 @@ HOUSNER = 1.0 - 1.5 * np.sin(ALPHA) ** 2
 LIGHT_SHIP = 10.0
 
 
-def free_rocking(k, damping, ship_mass=LIGHT_SHIP, omega0=0.4, duration=1.5, dt=1e-3, mu=0.9):
+def free_rocking(k, damping, ship_mass=LIGHT_SHIP, omega0=0.4, duration=1.5, dt=1e-3, mu=0.9,
+                 top_ratio=1.0):
     """Measured restitutions of the successive impacts of free rocking and the closed form.
 
     The bottom caps have stiffness ``k`` per block; the top caps carry the ship with the same
     natural frequency (``k`` scaled by the ship's share of the mass when the ship is lighter
-    than the line, so that a very light ship does not set a tiny step). Both interfaces stick
-    (mu = 0.9 on squat contact forces). Returns (e per impact, e_sys, result).
+    than the line, so that a very light ship does not set a tiny step), times ``top_ratio``.
+    Both interfaces stick (mu = 0.9 on squat contact forces). Returns (e per impact, e_sys,
+    result).
     """
     m = Block(half_width=HALF_WIDTH, half_height=HALF_HEIGHT).block_mass
-    top = Cap(stiffness=k * min(1.0, ship_mass / (N_BLOCKS * m)), mu_s=mu, mu_k=mu,
+    top = Cap(stiffness=top_ratio * k * min(1.0, ship_mass / (N_BLOCKS * m)), mu_s=mu, mu_k=mu,
               damping_ratio=damping)
     bottom = Cap(stiffness=k, mu_s=mu, mu_k=mu, damping_ratio=damping)
     blk = Block(half_width=HALF_WIDTH, half_height=HALF_HEIGHT, top=top, bottom=bottom)
@@ -121,19 +123,31 @@ def test_damping_ratio_above_two_gives_the_plastic_impact_and_below_one_less_los
     assert np.all(e[:2] > e_sys + 5e-3)
 
 
-def test_heavy_ship_first_impact_is_the_rigid_systems_plastic_impact():
-    """A 200 t ship on four 2.8 t blocks (M_n = 0.056): the first impact loses the rigid
-    system's plastic value (e_sys = 0.836, Housner's 0.876 would be wrong); the ship's top
-    contact opens after the impacts (the reference's brief lift-off)."""
-    errors = []
-    for k in (1e10, 1e11):
-        e, e_sys, res = free_rocking(k, damping=5.0, ship_mass=2e5, omega0=0.2)
-        errors.append(abs(e[0] - e_sys))
+def test_heavy_ship_first_impact_is_near_the_rigid_systems_plastic_impact():
+    """A 200 t ship on four 2.8 t blocks (M_n = 0.056): with equal top and bottom caps the first
+    impact loses close to the rigid system's plastic value (e_sys = 0.836, Housner's 0.876 would
+    be wrong), but the compliant limit is not e_sys: e - e_sys = -9.8e-5, +5.3e-4, +5.6e-4 at
+    k = 1e11, 1e12, 1e13. The ship's top contact opens after the impacts (the reference's brief
+    lift-off)."""
+    for k in (1e11, 1e12):
+        e, e_sys, res = free_rocking(k, damping=5.0, ship_mass=2e5, omega0=0.2, duration=0.9)
+        assert abs(e[0] - e_sys) < 1e-3
         detach = sum(ev.kind == "spring_detaches" and ev.where.startswith("keel_top")
                      for ev in res.events)
-        assert detach >= 3
+        assert detach >= 2
+    assert e[0] - e_sys > 3e-4  # levelled off above e_sys at 1e12, not converging to it
     assert e_sys < HOUSNER - 0.03
-    assert errors[1] < errors[0] / 10 and errors[1] < 1e-3
+
+
+def test_two_contact_impact_depends_on_the_ratio_of_the_caps_stiffnesses():
+    """The rocking impact under a heavy ship is a two-contact impact (the heel on the floor, the
+    new top corner under the ship): its compliant limit depends on the ratio of the two caps'
+    stiffnesses, so no single rigid rule is the limit of every dock. With top caps ten times
+    stiffer than the bottom ones it loses markedly less than the plastic rule (e - e_sys =
+    +2.1e-2, +1.2e-2, +9.6e-3 at k = 1e11, 1e12, 1e13: docs/theory/section.md)."""
+    e, e_sys, _ = free_rocking(1e11, damping=5.0, ship_mass=2e5, omega0=0.2, duration=0.9,
+                               top_ratio=10.0)
+    assert e[0] - e_sys > 1e-2
 
 
 def test_forced_rocking_with_a_ship_on_top_converges_to_the_plastic_rigid_model():
