@@ -75,6 +75,15 @@ def _cap(rng) -> Cap:
                mu_s=mu_s, mu_k=mu_s * rng.uniform(0.7, 1.0), shear_ratio=rng.uniform(0.2, 1.0))
 
 
+def _blocks_for(mass: float, blk: Block, rng) -> int:
+    """Blocks enough for ``mass`` to press the weaker cap at 10-60 % of its proportional limit
+    on average (as a docking plan sizes a line; the campaign would otherwise mostly draw docks
+    whose caps crush at rest)."""
+    sigma = min(blk.top.proportional_limit, blk.bottom.proportional_limit)
+    area = 2.0 * blk.half_width * blk.length
+    return max(2, math.ceil(mass * STANDARD_GRAVITY / (rng.uniform(0.1, 0.6) * sigma * area)))
+
+
 def random_dock(rng) -> tuple[DockSection, dict]:
     """A random dock section and a short description of its kind."""
     keel_blk = Block(half_width=rng.uniform(0.4, 0.8), half_height=rng.uniform(0.45, 1.0),
@@ -92,20 +101,23 @@ def random_dock(rng) -> tuple[DockSection, dict]:
         top = _cap(rng)
         b = rng.uniform(0.3, 0.7)
         hull = rng.uniform(0.0, 0.5)
-        gap = rng.uniform(-0.5, 0.5) * top.thickness  # gap (> 0) or interference at rest
+        # gap (> 0) or interference at rest, within the cap's compression at its proportional
+        # limit (a larger interference crushes the cap when the ship is set down)
+        gap = rng.uniform(-0.3, 1.0) * top.thickness * top.proportional_limit / top.modulus
         blk = Block(half_width=b, half_height=keel_blk.half_height + (hull - gap) / 2,
                     length=rng.uniform(0.8, 1.5), top=top, bottom=_cap(rng))
         inner = max(keel_blk.half_width, ship.keel_half_width) + b + 0.05
         offset = rng.uniform(inner, max(inner, beam - b))
         moving.append(bool(rng.uniform() < 0.6))
-        sides.append(BlockLine(block=blk, n_blocks=int(rng.integers(1, 5)), offset=sign * offset,
+        sides.append(BlockLine(block=blk, n_blocks=_blocks_for(0.3 * mass, blk, rng),
+                               offset=sign * offset,
                                moving=moving[-1], hull_height=hull,
                                hull_slope=sign * rng.uniform(0.0, 0.3)))
     wind = None
     if rng.uniform() < 0.5:
         wind = Wind(height=rng.uniform(0.5, 1.5) * (ship.g_height + 2.0),
                     force=rng.uniform(-0.03, 0.03) * mass * STANDARD_GRAVITY)
-    dock = DockSection(ship, BlockLine(block=keel_blk, n_blocks=int(rng.integers(2, 9))),
+    dock = DockSection(ship, BlockLine(block=keel_blk, n_blocks=_blocks_for(mass, keel_blk, rng)),
                        tuple(sides), wind=wind, n_springs=int(rng.integers(2, 8)))
     kind = {"sides": n_sides, "moving": moving, "wind": wind is not None,
             "n_springs": dock.n_springs}
