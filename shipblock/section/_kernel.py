@@ -5,7 +5,7 @@ block line), each with state ``(y, z, angle)`` in the floor's frame, joined by *
 of a block face (carried by body ``C``: a moving line, or a fixed line whose pose is given)
 pressed against a straight surface of body ``S`` (the ship's hull, or the floor). A strip holds
 ``n`` compression-only springs at Gauss-Lobatto points of the face and one tangential stick spring
-at the face's centre. :mod:`shipblock.section.model` explains every law; this module only
+at the centre of pressure of their forces. :mod:`shipblock.section.model` explains every law; this module only
 evaluates them.
 
 State vector: ``q`` (3 per body), ``v`` (3 per body), ``u`` (stick-spring extension per strip),

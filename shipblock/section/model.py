@@ -36,11 +36,14 @@ area ``A_i = A w_i / 2`` (``A`` the face's area along its slope):
   the strip carries by the stiffness rule: the ship's mass shared among the strips under it in
   proportion to their vertical stiffness, plus the line's own mass for a floor strip.
 
-Friction acts per strip on its total normal force ``N``, at the centre of C's face along the
-tangent ``t = (n_z, -n_y)``: a stick spring ``F_t = -k_t u - c_t v_t`` (``k_t`` the cap's
-``shear_ratio`` times ``k_strip``, ``c_t = 2 zeta sqrt(k_t m_eff)``), with ``u`` the tangential
-coordinate of C's face centre in S's frame since the last stick point (whose rate is exactly the
-relative tangential velocity ``v_t``); slip when ``|F_t|`` reaches ``mu_s N``, then
+Friction acts per strip on its total normal force ``N``, at the strip's centre of pressure (the
+point of C's face where the resultant of its spring forces acts: the loaded corner of a rocking
+block, as the rigid model's sticking pivot; the face centre while the strip carries nothing)
+along the tangent ``t = (n_z, -n_y)``: a stick spring ``F_t = -k_t u - c_t v_t`` (``k_t`` the
+cap's ``shear_ratio`` times ``k_strip``, ``c_t = 2 zeta sqrt(k_t m_eff)``), with ``u`` the
+integral since the last stick point of ``v_t``, the relative tangential velocity of C's material
+point at the centre of pressure (the force acts where its rate is taken: the energy balance is
+exact; at rest ``u`` is the displacement of the face centre, see *Initial state*); slip when ``|F_t|`` reaches ``mu_s N``, then
 ``F_t = -mu_k N sign(v_t)``; stick again, with ``u = 0``, when ``v_t`` changes sign. The stick
 spring's energy at a slip onset is counted as friction loss.
 
