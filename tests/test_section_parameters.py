@@ -101,6 +101,23 @@ def test_lobatto_rule_integrates_to_degree_2n_minus_3(n):
     (lambda: DockSection(ship(), BlockLine(), (side(3.0, hull_height=0.5),)), "gap of"),
     (lambda: DockSection(ship(), BlockLine(offset=1.0)), "DockSection.keel"),
     (lambda: DockSection(ship(), BlockLine(), n_springs=1), "DockSection.n_springs"),
+    # issue 29's bad input, each named by its key
+    (lambda: Cap(stiffness=-1e9), "Cap.stiffness"),
+    (lambda: Cap(modulus=-1e9), "Cap.modulus"),
+    (lambda: Cap(shear_ratio=0.0), "Cap.shear_ratio"),
+    (lambda: Cap(proportional_limit=0.0), "Cap.proportional_limit"),
+    (lambda: Cap(proportional_limit=-7e6), "Cap.proportional_limit"),
+    (lambda: Block(capacity=-1e6), "Block.capacity"),
+    (lambda: Block(mass=0.0), "Block.mass"),
+    (lambda: Block(half_height=0.1), "caps thicker"),
+    (lambda: ship(g_height=0.0), "G below the keel"),
+    (lambda: ship(roll_inertia=0.0), "Ship.roll_inertia"),
+    (lambda: ship(mass=-4e5), "Ship.mass"),
+    (lambda: DockSection(ship(), BlockLine(), (side(-6.0),)), "not under the hull"),
+    (lambda: BlockLine(hull_slope=-math.radians(46)), "cannot be cut"),
+    # a 2 m wide block 1 m tall: tan(40 deg) * 1 m reaches through its 0.7 m core
+    (lambda: BlockLine(block=Block(half_width=1.0, half_height=0.5), hull_slope=math.radians(40)),
+     "BlockLine.hull_slope"),
 ])
 def test_bad_values_are_refused_by_key(make, key):
     with pytest.raises(ParameterError, match=key):

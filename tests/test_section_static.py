@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from shipblock.errors import ParameterError
-from shipblock.section import Block, BlockLine, Cap, DockSection, Ship, Wind
+from shipblock.section import NAVY_BLOCK, Block, BlockLine, Cap, DockSection, Ship, Wind
 from shipblock.section import _kernel as K
 from shipblock.section.model import assemble, static_state
 
@@ -169,3 +169,33 @@ def test_a_side_line_that_would_slide_at_rest_is_refused():
     sec = DockSection(ship, BlockLine(n_blocks=4), (side,))
     with pytest.raises(ParameterError, match=r"DockSection.sides\[0\]: at rest its .* face needs"):
         static_state(assemble(sec))
+
+
+def test_side_lines_preloaded_by_an_interference_lift_the_ship_off_the_keel():
+    """Both side lines 2 mm taller than the hull above them (an interference the parameters
+    accept): the preload of their caps (3e7 N per line at 2 mm) exceeds the weight, so at rest
+    the ship sits on the side lines alone, the keel line's top open, and the vertical components
+    of the side loads carry the weight. (Powell's method alone stalled on this kink of the
+    residual and refused the dock as having no static solution: found by the random campaign.)"""
+    ship = Ship(mass=6e5, roll_inertia=6e5 * 9.0, g_height=4.0, keel_half_width=0.8,
+                half_beam=6.0, g_offset=0.3)
+    side = Block(half_height=NAVY_BLOCK.half_height + 0.15 + 0.001)
+    sides = tuple(BlockLine(block=side, n_blocks=2, offset=s * 3.5, hull_height=0.3,
+                            hull_slope=s * 0.08, moving=False) for s in (-1, 1))
+    dock = DockSection(ship, BlockLine(n_blocks=4), sides)
+    assert dock.side_gap(0) == pytest.approx(-0.002)
+    asm = assemble(dock)
+    init = static_state(asm)
+    keel_top = [j for j in range(asm.n_strips) if asm.strip_top[j] and asm.strip_line[j] == 0]
+    assert init.normal[keel_top[0]] == 0.0
+    weight = ship.mass * dock.g
+    sides_top = [j for j in range(asm.n_strips) if asm.strip_top[j] and asm.strip_line[j] > 0]
+    # on the ship: -(N n + F_t t), t = (n_z, -n_y), F_t = -k_t u of the stick spring (the ship's
+    # roll, 1e-5 rad, left out)
+    nb = asm.n_bodies
+    vertical = sum(-init.normal[j] * asm.strip_f[j, K.SF_SNZ]
+                   - asm.strip_f[j, K.SF_KT] * init.x[6 * nb + j] * asm.strip_f[j, K.SF_SNY]
+                   for j in sides_top)
+    assert vertical == pytest.approx(weight, rel=1e-4)
+    # G off to starboard: the starboard line carries more
+    assert init.normal[sides_top[1]] > init.normal[sides_top[0]]

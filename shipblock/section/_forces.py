@@ -8,7 +8,8 @@ block line), each with state ``(y, z, angle)`` in the floor's frame, joined by *
 of a block face (carried by body ``C``: a moving line, or a fixed line whose pose is given)
 pressed against a straight surface of body ``S`` (the ship's hull, or the floor). A strip holds
 ``n`` compression-only springs at Gauss-Lobatto points of the face and one tangential stick spring
-at the face's centre. :mod:`shipblock.section.model` explains every law; this module only
+at the centre of pressure of their forces (:func:`friction_offset`; the face centre while the
+strip carries nothing). :mod:`shipblock.section.model` explains every law; this module only
 evaluates them.
 
 State vector: ``q`` (3 per body), ``v`` (3 per body), ``u`` (stick-spring extension per strip),
@@ -106,7 +107,8 @@ def _frame(x, nb, j, strip_f, strip_i):
 
 @njit(cache=True, inline="always")
 def kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
-    """Closure and closure rate of every spring, tangential slip rate of every strip.
+    """Closure and closure rate of every spring, tangential slip rate of every strip at its face
+    centre (:func:`contact_forces` moves it to the centre of pressure of a loaded strip).
 
     ``pos[i] = (py, pz)`` is the world position of spring i's point on C (where its force acts).
     """
@@ -125,6 +127,35 @@ def kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
 
 
 @njit(cache=True, inline="always")
+def friction_offset(total, f_ra, ra_first, ra_last, dc):
+    """Offset along n from c (``r . a``, see :func:`_frame`) of the point of C's face where the
+    strip's friction acts and its slip is measured: the centre of pressure of its spring forces,
+    ``sum f_i (r_i . a) / sum f_i`` (a rocking block's loaded corner, as the sticking pivot of
+    the rigid model), or the face centre's ``dc`` while the strip carries nothing.
+
+    Only ``r . a`` of that point enters the slip rate ``w (r . a) - T0`` and the tangential
+    force's moments, and it is a ratio of sums, so the per-regime sums give it as well
+    (:func:`stage_rhs`). It is kept between the face's end springs ``ra_first``, ``ra_last``:
+    with every spring force >= 0 (any state the event functions accept) the centre of pressure
+    lies there anyway; the bound only keeps a stage's trial state, where a spring about to
+    detach may pull, from putting the point off the face.
+    """
+    if total <= 0.0:
+        return dc
+    p = f_ra / total
+    lo, hi = min(ra_first, ra_last), max(ra_first, ra_last)
+    return min(max(p, lo), hi)
+
+
+@njit(cache=True, inline="always")
+def _face_ends(spring_f, first, count, a1, a2):
+    """``r . a`` of the strip's first and last springs (the ends of the face: Lobatto points)."""
+    last = first + count - 1
+    return (spring_f[first, PF_RY] * a1 + spring_f[first, PF_RZ] * a2,
+            spring_f[last, PF_RY] * a1 + spring_f[last, PF_RZ] * a2)
+
+
+@njit(cache=True, inline="always")
 def cap_surface(k, c, dp, dc0, t0, t):
     """Compression of a detached cap at time t: it relaxes from dc0 towards its set dp."""
     if c <= 0.0 or dc0 <= dp:
@@ -135,10 +166,12 @@ def cap_surface(k, c, dp, dc0, t0, t):
 @njit(cache=True, inline="always")
 def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, delta_dot, vt,
                    fe, fn, normal, tang):
-    """Spring forces (total ``fn``, elastic ``fe``) and strip normal/tangential forces."""
+    """Spring forces (total ``fn``, elastic ``fe``) and strip normal/tangential forces; the slip
+    rate ``vt`` of a loaded strip moved to its centre of pressure (:func:`friction_offset`)."""
     for j in range(strip_i.shape[0]):
         first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
         total = 0.0
+        f_delta = 0.0  # sum f delta: r . a = D0 - delta of every spring
         for i in range(first, first + count):
             k, c, fy = spring_f[i, PF_K], spring_f[i, PF_C], spring_f[i, PF_FY]
             if reg[i] == R_ELASTIC:
@@ -151,7 +184,14 @@ def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, d
                 fe[i] = 0.0
                 fn[i] = 0.0
             total += fn[i]
+            f_delta += fn[i] * delta[i]
         normal[j] = total
+        if total > 0.0:
+            (cb, sb, ny, nz, a1, a2, d0, e0, w, l0, cy, cz, cc, cs, t0,
+             p0) = _frame(x, nb, j, strip_f, strip_i)
+            ra_a, ra_b = _face_ends(spring_f, first, count, a1, a2)
+            dc = strip_f[j, SF_CY] * a1 + strip_f[j, SF_CZ] * a2
+            vt[j] = w * friction_offset(total, total * d0 - f_delta, ra_a, ra_b, dc) - t0
         if fs[j] == F_STICK:
             tang[j] = -strip_f[j, SF_KT] * x[o_u + j] - strip_f[j, SF_CT] * vt[j]
         elif fs[j] == F_FREE:
@@ -189,7 +229,8 @@ def _strip_load(x, nb, j, strip_f, fs, cb, sb, ny, nz, l0, p0, total, moment, dc
     """Friction of strip j (stick spring, kinetic or none) and the strip's normal force
     ``total`` (moment ``moment`` about c) and friction applied to C, the opposite to S.
 
-    ``dc`` is C's face centre's offset along n from c, ``vtj`` its slip rate. Returns the
+    ``dc`` is the offset along n from c of the point of C where the friction acts (the centre
+    of pressure, :func:`friction_offset`), ``vtj`` its slip rate. Returns the
     friction force and the strip's damping (stick dashpot) and friction loss rates."""
     o_v, o_u = 3 * nb, 6 * nb
     d_damp = 0.0
@@ -267,10 +308,12 @@ def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, op
         first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
         total = 0.0
         moment = 0.0  # sum of f m: the springs' moment about c
+        f_ra = 0.0  # sum of f (r . a): the centre of pressure's offset times the normal force
         for i in range(first, first + count):
             ry, rz = spring_f[i, PF_RY], spring_f[i, PF_RZ]
             m = ry * a2 - rz * a1
-            di = d0 - (ry * a1 + rz * a2)
+            ra = ry * a1 + rz * a2
+            di = d0 - ra
             ddi = e0 + w * m
             delta[i] = di
             delta_dot[i] = ddi
@@ -291,9 +334,12 @@ def rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, op
             fn[i] = f
             total += f
             moment += f * m
+            f_ra += f * ra
         normal[j] = total
-        # C's face centre: its offset along n from c and its slip rate
-        dc = strip_f[j, SF_CY] * a1 + strip_f[j, SF_CZ] * a2
+        # the friction point (centre of pressure): its offset along n from c and its slip rate
+        ra_a, ra_b = _face_ends(spring_f, first, count, a1, a2)
+        dc = friction_offset(total, f_ra, ra_a, ra_b,
+                             strip_f[j, SF_CY] * a1 + strip_f[j, SF_CZ] * a2)
         vtj = w * dc - t0
         vt[j] = vtj
         ft, dd, df = _strip_load(x, nb, j, strip_f, fs, cb, sb, ny, nz, l0, p0, total, moment,
@@ -353,16 +399,18 @@ def regime_sums(strip_i, spring_f, reg, dp, sums):
 
 
 @njit(cache=True)
-def stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z, dt_rec, sums,
-              xdot):
+def stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y, ag_z, dt_rec,
+              sums, xdot):
     """:func:`rhs` from the regime sums (:func:`regime_sums`): a strip costs the same whatever
     its number of springs, and no spring's force is kept (the integrator's inner stages).
 
     With a spring's closure ``delta_i = D0 - dp_i - (ry a1 + rz a2)``, rate ``E0 + w m_i`` and
     arm ``m_i = ry a2 - rz a1`` (:func:`_frame`), the strip's normal force ``sum f_i`` and
     moment ``sum f_i m_i`` are linear and quadratic forms in ``(a1, a2)`` with the sums as
-    coefficients; the damping loss rate ``sum c_i (E0 + w m_i)^2`` likewise. Equal to
-    :func:`rhs` but for rounding.
+    coefficients; the damping loss rate ``sum c_i (E0 + w m_i)^2`` likewise, and the
+    centre of pressure where the friction acts (``sum f_i (r_i . a) / sum f_i``,
+    :func:`friction_offset`) from one more quadratic form. Equal to :func:`rhs` but for
+    rounding.
     """
     ay, az = _start_rates(t, x, nb, mass, opt, ag_y, ag_z, dt_rec, xdot)
     d_damp = 0.0
@@ -382,7 +430,14 @@ def stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z
         moment = (d0 * k_m - (sm[RS_KDY] * a2 - sm[RS_KDZ] * a1) - k_ra_m
                   + sm[RS_FY] * a2 - sm[RS_FZ] * a1 + e0 * c_m + w * c_mm)
         d_damp += e0 * e0 * sm[RS_C] + 2.0 * e0 * w * c_m + w * w * c_mm
-        dc = strip_f[j, SF_CY] * a1 + strip_f[j, SF_CZ] * a2
+        # sum f (r . a) for the centre of pressure, where the friction acts
+        f_ra = (d0 * k_ra - (sm[RS_KDY] * a1 + sm[RS_KDZ] * a2)
+                - (a1 * a1 * sm[RS_KYY] + 2.0 * a1 * a2 * sm[RS_KYZ] + a2 * a2 * sm[RS_KZZ])
+                + sm[RS_FY] * a1 + sm[RS_FZ] * a2 + e0 * (sm[RS_CY] * a1 + sm[RS_CZ] * a2)
+                + w * (a1 * a2 * (sm[RS_CYY] - sm[RS_CZZ]) + (a2 * a2 - a1 * a1) * sm[RS_CYZ]))
+        ra_a, ra_b = _face_ends(spring_f, strip_i[j, SI_FIRST], strip_i[j, SI_COUNT], a1, a2)
+        dc = friction_offset(total, f_ra, ra_a, ra_b,
+                             strip_f[j, SF_CY] * a1 + strip_f[j, SF_CZ] * a2)
         _, dd, df = _strip_load(x, nb, j, strip_f, fs, cb, sb, ny, nz, l0, p0, total, moment,
                                 dc, w * dc - t0, xdot)
         d_damp += dd

@@ -92,10 +92,16 @@ def _event_values_of(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0
     phi = x[2]
     gv[o + 1] = opt[O_TIP_POS] - phi if phi >= 0.0 else opt[O_TIP_NEG] + phi
     gv[o + 2] = opt[O_SEP] - min_gap
-    # validity: displacements and rotations within what the model is written for
+    # validity: displacements (from the body's place as built: G's offset for the ship, the
+    # line's offset for a block line) and rotations within what the model is written for
     worst = 0.0
     for b in range(nb):
-        worst = max(worst, abs(x[3 * b]) / opt[O_MAX_DISP])
+        ref = -strip_f[0, SF_SQY]  # strip 0 is the keel top, its surface point -g_offset on S
+        if b > 0:
+            for j in range(strip_i.shape[0]):
+                if strip_i[j, SI_C] == b:
+                    ref = strip_f[j, SF_PY]
+        worst = max(worst, abs(x[3 * b] - ref) / opt[O_MAX_DISP])
         worst = max(worst, abs(x[3 * b + 2]) / opt[O_MAX_ANGLE])
     gv[o + 3] = 1.0 - worst
 
@@ -210,24 +216,24 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             break
         for m in range(nx):
             y[m] = x[m] + h * _A21 * k1[m]
-        stage_rhs(t + h / 5.0, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
-                  dt_rec, sums, k2)
+        stage_rhs(t + h / 5.0, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
+                  ag_z, dt_rec, sums, k2)
         for m in range(nx):
             y[m] = x[m] + h * (_A31 * k1[m] + _A32 * k2[m])
-        stage_rhs(t + 0.3 * h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
-                  dt_rec, sums, k3)
+        stage_rhs(t + 0.3 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
+                  ag_z, dt_rec, sums, k3)
         for m in range(nx):
             y[m] = x[m] + h * (_A41 * k1[m] + _A42 * k2[m] + _A43 * k3[m])
-        stage_rhs(t + 0.8 * h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
-                  dt_rec, sums, k4)
+        stage_rhs(t + 0.8 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
+                  ag_z, dt_rec, sums, k4)
         for m in range(nx):
             y[m] = x[m] + h * (_A51 * k1[m] + _A52 * k2[m] + _A53 * k3[m] + _A54 * k4[m])
-        stage_rhs(t + 8.0 / 9.0 * h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
-                  dt_rec, sums, k5)
+        stage_rhs(t + 8.0 / 9.0 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt,
+                  ag_y, ag_z, dt_rec, sums, k5)
         for m in range(nx):
             y[m] = x[m] + h * (_A61 * k1[m] + _A62 * k2[m] + _A63 * k3[m] + _A64 * k4[m]
                                + _A65 * k5[m])
-        stage_rhs(t + h, y, nb, ns, mass, inertia, strip_f, strip_i, fs, opt, ag_y, ag_z,
+        stage_rhs(t + h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y, ag_z,
                   dt_rec, sums, k6)
         for m in range(nx):
             x1[m] = x[m] + h * (_B1 * k1[m] + _B3 * k3[m] + _B4 * k4[m] + _B5 * k5[m]

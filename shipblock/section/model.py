@@ -36,11 +36,14 @@ area ``A_i = A w_i / 2`` (``A`` the face's area along its slope):
   the strip carries by the stiffness rule: the ship's mass shared among the strips under it in
   proportion to their vertical stiffness, plus the line's own mass for a floor strip.
 
-Friction acts per strip on its total normal force ``N``, at the centre of C's face along the
-tangent ``t = (n_z, -n_y)``: a stick spring ``F_t = -k_t u - c_t v_t`` (``k_t`` the cap's
-``shear_ratio`` times ``k_strip``, ``c_t = 2 zeta sqrt(k_t m_eff)``), with ``u`` the tangential
-coordinate of C's face centre in S's frame since the last stick point (whose rate is exactly the
-relative tangential velocity ``v_t``); slip when ``|F_t|`` reaches ``mu_s N``, then
+Friction acts per strip on its total normal force ``N``, at the strip's centre of pressure (the
+point of C's face where the resultant of its spring forces acts: the loaded corner of a rocking
+block, as the rigid model's sticking pivot; the face centre while the strip carries nothing)
+along the tangent ``t = (n_z, -n_y)``: a stick spring ``F_t = -k_t u - c_t v_t`` (``k_t`` the
+cap's ``shear_ratio`` times ``k_strip``, ``c_t = 2 zeta sqrt(k_t m_eff)``), with ``u`` the
+integral since the last stick point of ``v_t``, the relative tangential velocity of C's material
+point at the centre of pressure (the force acts where its rate is taken: the energy balance is
+exact; at rest ``u`` is the displacement of the face centre, see *Initial state*); slip when ``|F_t|`` reaches ``mu_s N``, then
 ``F_t = -mu_k N sign(v_t)``; stick again, with ``u = 0``, when ``v_t`` changes sign. The stick
 spring's energy at a slip onset is counted as friction loss.
 
@@ -55,6 +58,7 @@ rest is refused.
 from __future__ import annotations
 
 import math
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -357,6 +361,91 @@ def _forces(asm: Assembly, q: np.ndarray, u: np.ndarray):
     return x, gen, reg, fs, normal, fn
 
 
+#: Scale of the static solver's unknowns [m, m, rad].
+_SCALE_Q = 1e-3
+#: Steps of the continuation in the side lines' gaps (see :func:`static_state`).
+_GAP_STEPS = 10
+
+
+def _free(asm: Assembly) -> np.ndarray:
+    free = np.ones(3 * asm.n_bodies, dtype=bool)
+    if asm.section.roll_held:
+        free[2] = False
+    return free
+
+
+def _residual(asm: Assembly):
+    """The static residual (generalised forces over the weight) of the free displacements from
+    ``asm.q0`` (scaled by ``_SCALE_Q``), and the map from those to the positions."""
+    free = _free(asm)
+    u0 = tangent_coordinates(asm, asm.q0)
+    scale_f = asm.mass.sum() * asm.section.g
+
+    def unpack(z):
+        q = asm.q0.copy()
+        q[free] += z * _SCALE_Q
+        return q
+
+    def residual(z):
+        q = unpack(z)
+        _, gen, *_ = _forces(asm, q, tangent_coordinates(asm, q) - u0)
+        return gen[free] / scale_f
+
+    return residual, unpack
+
+
+def _solve(residual, z0) -> tuple[np.ndarray, float]:
+    """Powell's hybrid method from ``z0``; where it stalls on a kink of the piecewise smooth
+    residual (a side line's preload lifting the ship off the keel line), the trust-region
+    least-squares method from the same start. Returns the solution and its largest residual."""
+    sol = optimize.root(residual, z0, method="hybr", options={"xtol": 1e-13, "maxfev": 20000})
+    worst = float(np.max(np.abs(residual(sol.x))))
+    if worst < 1e-9:
+        return sol.x, worst
+    lsq = optimize.least_squares(residual, z0, xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=2000)
+    worst_lsq = float(np.max(np.abs(residual(lsq.x))))
+    return (lsq.x, worst_lsq) if worst_lsq < worst else (sol.x, worst)
+
+
+def _sunk(asm: Assembly) -> np.ndarray:
+    """Every body lowered by the static deflection of its own supports: a start from which the
+    loaded springs are closed at the first iteration (the residual is piecewise smooth)."""
+    nb = asm.n_bodies
+    sink = np.zeros(3 * nb)
+    g = asm.section.g
+    k_top = sum(asm.spring_f[asm.strip_i[j, K.SI_FIRST]:asm.strip_i[j, K.SI_FIRST]
+                             + asm.strip_i[j, K.SI_COUNT], K.PF_K].sum()
+                for j in range(asm.n_strips) if asm.strip_top[j])
+    for j in range(asm.n_strips):
+        springs = slice(asm.strip_i[j, K.SI_FIRST], asm.strip_i[j, K.SI_FIRST]
+                        + asm.strip_i[j, K.SI_COUNT])
+        if not asm.strip_top[j]:
+            b = asm.strip_i[j, K.SI_C]
+            sink[3 * b + 1] = -asm.m_eff[j] * g / asm.spring_f[springs, K.PF_K].sum()
+    sink[1] = -asm.mass[0] * g / k_top + min(sink[1::3].min(), 0.0)
+    return sink
+
+
+def _by_continuation(asm: Assembly) -> tuple[np.ndarray, float]:
+    """The static solution reached by opening the side lines' gaps (or interferences) from zero
+    to their values in ``_GAP_STEPS`` steps, each solved from the last (Powell's method alone
+    does not find it from the sunk start when a gap makes the ship roll onto a line)."""
+    sec = asm.section
+    sep = asm.opt[K.O_SEP]
+    z = None
+    for frac in np.linspace(0.0, 1.0, _GAP_STEPS + 1):
+        if frac < 1.0:
+            sides = tuple(dataclasses.replace(line, block=dataclasses.replace(
+                line.block, half_height=line.block.half_height + (1.0 - frac) * sec.side_gap(i) / 2))
+                for i, line in enumerate(sec.sides))
+            step = assemble(dataclasses.replace(sec, sides=sides), sep)
+        else:
+            step = asm
+        residual, _ = _residual(step)
+        z, worst = _solve(residual, _sunk(step)[_free(step)] / _SCALE_Q if z is None else z)
+    return z, worst
+
+
 def static_state(asm: Assembly) -> InitialState:
     """The elastic static solution under gravity and steady wind, every loaded strip sticking.
 
@@ -370,47 +459,22 @@ def static_state(asm: Assembly) -> InitialState:
         would crush under the static load (naming the line).
     """
     nb = asm.n_bodies
-    held = asm.section.roll_held
-    free = np.ones(3 * nb, dtype=bool)
-    if held:
-        free[2] = False
-    u0 = tangent_coordinates(asm, asm.q0)
-    scale_q = 1e-3
+    free = _free(asm)
     scale_f = asm.mass.sum() * asm.section.g
-
-    def unpack(z):
-        q = asm.q0.copy()
-        q[free] += z * scale_q
-        return q
-
-    def residual(z):
-        q = unpack(z)
-        _, gen, *_ = _forces(asm, q, tangent_coordinates(asm, q) - u0)
-        return gen[free] / scale_f
-
-    # start from every body lowered by the static deflection of its own supports, so that the
-    # loaded springs are closed from the first iteration (the residual is piecewise smooth)
-    sink = np.zeros(3 * nb)
-    g = asm.section.g
-    k_top = sum(asm.spring_f[asm.strip_i[j, K.SI_FIRST]:asm.strip_i[j, K.SI_FIRST]
-                             + asm.strip_i[j, K.SI_COUNT], K.PF_K].sum()
-                for j in range(asm.n_strips) if asm.strip_top[j])
-    for j in range(asm.n_strips):
-        springs = slice(asm.strip_i[j, K.SI_FIRST], asm.strip_i[j, K.SI_FIRST]
-                        + asm.strip_i[j, K.SI_COUNT])
-        if not asm.strip_top[j]:
-            b = asm.strip_i[j, K.SI_C]
-            sink[3 * b + 1] = -asm.m_eff[j] * g / asm.spring_f[springs, K.PF_K].sum()
-    sink[1] = -asm.mass[0] * g / k_top + min(sink[1::3].min(), 0.0)
-    z0 = sink[free] / scale_q
-    sol = optimize.root(residual, z0, method="hybr", options={"xtol": 1e-13, "maxfev": 20000})
-    q = unpack(sol.x)
-    x, gen, reg, fs, normal, fn = _forces(asm, q, tangent_coordinates(asm, q) - u0)
-    worst = np.max(np.abs(gen[free])) / scale_f
+    residual, unpack = _residual(asm)
     # what rounding of the positions leaves unbalanced in the stiffest spring, times 100
-    floor = 100 * np.finfo(float).eps * asm.spring_f[:, K.PF_K].max() * max(
-        1.0, np.abs(q).max()) * asm.spring_f.shape[0] / scale_f
-    if not (worst < 1e-8 + floor):
+    def floor(z):
+        return 100 * np.finfo(float).eps * asm.spring_f[:, K.PF_K].max() * max(
+            1.0, np.abs(unpack(z)).max()) * asm.spring_f.shape[0] / scale_f
+
+    z, worst = _solve(residual, _sunk(asm)[free] / _SCALE_Q)
+    if not worst < 1e-8 + floor(z) and any(asm.section.side_gap(i) != 0.0
+                                           for i in range(len(asm.section.sides))):
+        z, worst = _by_continuation(asm)
+    q = unpack(z)
+    x, gen, reg, fs, normal, fn = _forces(asm, q, tangent_coordinates(asm, q)
+                                          - tangent_coordinates(asm, asm.q0))
+    if not (worst < 1e-8 + floor(z)):
         raise ParameterError(
             f"the section has no static solution under gravity (largest unbalanced force "
             f"{worst:.2e} of the weight): the ship is not stable on its supports at rest; add side "
@@ -422,8 +486,8 @@ def static_state(asm: Assembly) -> InitialState:
     step = 1e-7
     for m in range(n_free):
         dz = np.zeros(n_free)
-        dz[m] = step / scale_q
-        stiff[:, m] = -(residual(sol.x + dz) - residual(sol.x - dz)) * scale_f / (2 * step)
+        dz[m] = step / _SCALE_Q
+        stiff[:, m] = -(residual(z + dz) - residual(z - dz)) * scale_f / (2 * step)
     stiff = 0.5 * (stiff + stiff.T)
     lowest = np.linalg.eigvalsh(stiff)[0]
     if lowest <= 0.0:

@@ -328,6 +328,15 @@ class BlockLine:
                 f"BlockLine.hull_slope must be within +-45 deg ({MAX_HULL_SLOPE:.4f} rad), got "
                 f"{self.hull_slope!r}: a block top cannot be cut to match it")
         _check(self, self.LIMITS)
+        blk = self.block
+        drop = blk.half_width * abs(math.tan(self.hull_slope))
+        core = 2.0 * blk.half_height - blk.top.thickness - blk.bottom.thickness
+        if drop >= core:
+            raise ParameterError(
+                f"BlockLine.hull_slope ({self.hull_slope!r} rad): a block top cut to it drops "
+                f"{drop:g} m from its centre to its low edge (Block.half_width * tan(hull_slope)), "
+                f"not less than the block's core between its caps ({core:g} m): a block top "
+                "cannot be cut to match it; use a wider-topped shore or a narrower block")
 
 
 def is_steep(slope) -> bool:
