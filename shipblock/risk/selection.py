@@ -586,7 +586,8 @@ def selection_lines(selection: Selection) -> list[str]:
     o = selection.options
     lines = [f"{len(selection.chosen)} of {len(selection.ranked)} records chosen "
              f"({o['horizontal']} horizontal"
-             + (", with the vertical" if o["vertical_target"] else "") + f", "
+             + (", with the vertical" if o["vertical_target"] else "")
+             + f", {100 * o['damping']:g} % damping, "
              f"{o['period_range_s'][0]:g} to {o['period_range_s'][1]:g} s)"]
     header = f"  {'rank':>4}  {'record':<32} {'factor':>8} {'misfit':>8} {'misfit H':>9}"
     if o["vertical_target"]:
