@@ -308,9 +308,9 @@ def test_at_most_n_records_per_earthquake_changes_the_suite_to_the_best_within_t
 
 def test_a_cap_the_catalogue_cannot_meet_and_an_unknown_earthquake_are_refused(
         event_catalogue, catalogue):
-    with pytest.raises(ParameterError, match=r"max_per_event = 1: the 5 matched records come "
-                                             r"from 3 earthquake\(s\), so at most 3 can be "
-                                             r"chosen, not k = 4"):
+    with pytest.raises(ParameterError, match=r"max_per_event = 1 \(--max-per-event\): the 5 "
+                                             r"matched records come from 3 earthquake\(s\), so "
+                                             r"at most 3 can be chosen, not k = 4 \(-k\)"):
         select(event_catalogue, 4, scale=False, max_per_event=1)
     with pytest.raises(ParameterError, match="max_per_event"):
         select(event_catalogue, 2, max_per_event=0)
@@ -354,3 +354,8 @@ def test_command_line_caps_records_per_earthquake(event_catalogue, tmp_path, cap
     assert list(back) == ["syn/r1", "syn/r4", "syn/r5"]
     assert [back[i].extra["selection_event"] for i in back] == ["smi:local/event/A", "B", "C"]
     assert "# At most 1 record(s) per earthquake" in out.read_text()
+    # the refusal names the flags a command-line user gave, not only the Python keywords
+    assert main(["-q", "select", str(event_catalogue), "--target", str(target), "-k", "4",
+                 "--no-scale", "--no-processing", "--max-per-event", "1", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "max_per_event = 1 (--max-per-event)" in err and "not k = 4 (-k)" in err
