@@ -183,6 +183,39 @@ def test_plot_command_draws_the_swept_value_asked_for_and_the_median_against_the
                                ds["median"].sel(limit_state="ship_slip").values / G)
 
 
+def test_plot_command_draws_the_limit_states_asked_for(sweep_run, tmp_path, capsys,
+                                                      monkeypatch):
+    # plot_fragility's and plot_median_sweep's limit_state existed only in Python
+    import shipblock.plot
+
+    tmp, _, ds = sweep_run
+    nc = tmp / "out" / "result.nc"
+    drawn = []
+    for name in ("plot_fragility", "plot_median_sweep"):
+        original = getattr(shipblock.plot, name)
+
+        def spy(*args, _original=original, **kw):
+            ax = _original(*args, **kw)
+            drawn.append([t.get_text().split(" (")[0] for t in ax.get_legend().get_texts()])
+            return ax
+
+        monkeypatch.setattr(shipblock.plot, name, spy)
+    names = [str(n) for n in ds["limit_state"].values]
+    assert len(names) >= 2
+    for kind in ("fragility", "median"):
+        assert main(["-q", "plot", str(nc), "--kind", kind, "--limit-state", names[1],
+                     "-o", str(tmp_path / f"{kind}.png")]) == 0
+        assert (tmp_path / f"{kind}.png").exists()
+    assert drawn == [[names[1]], [names[1]]]
+    assert main(["-q", "plot", str(nc), "--limit-state", "nope", "-o", str(tmp_path / "x.png")]) \
+        == 2
+    assert (f"--limit-state 'nope' is not a limit state of the study; limit states: "
+            f"{', '.join(names)}") in capsys.readouterr().err
+    assert main(["-q", "plot", str(nc), "--kind", "ida", "--limit-state", names[0], "-o",
+                 str(tmp_path / "x.png")]) == 2
+    assert "--limit-state draws with --kind fragility or median" in capsys.readouterr().err
+
+
 def test_cloud_figure_draws_each_records_outcome_at_its_intensity(tmp_path):
     path = write_pipeline(tmp_path, kind="cloud", levels="")
     ds = run_pipeline(path, progress=False)

@@ -141,6 +141,9 @@ def build_parser():
     s.add_argument("--against", metavar="NAME",
                    help="with --kind median: the swept parameter on the x axis (default: the "
                         "first)")
+    s.add_argument("--limit-state", action="append", metavar="NAME",
+                   help="with --kind fragility or median: draw only this limit state "
+                        "(repeatable; default: all)")
     s.set_defaults(func=cmd_plot)
 
     s = sub.add_parser("risk", help="risk over a docking period: fragility x site hazard",

@@ -376,7 +376,9 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
         label = f"{name} ({limit_state_text(ds, name)})"
         missing = [f"{v:g}" for v, m in zip(x, med, strict=True) if not np.isfinite(m)]
         if missing:
-            label += f"; not fitted at {parameter} = {', '.join(missing)}"
+            unit = swept_unit(ds, parameter)
+            label += (f"; not fitted at {parameter} = {', '.join(missing)}"
+                      + (f" {unit}" if unit else ""))
         ax.plot(xd, med, "-" + _MARKERS[i % len(_MARKERS)], color=c, lw=1.5, ms=5,
                 mfc="white", mew=1.5, label=label)
         if "median_lower" in ds:
