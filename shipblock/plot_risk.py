@@ -96,7 +96,7 @@ def plot_deaggregation(ds, limit_state=None, ax=None, sweep=None):
         ax.legend(fontsize="small")
     title = "deaggregation over the intensity"
     if sweep:
-        title += f" ({sweep_text(sweep)})"
+        title += f" ({sweep_text(sweep, ds)})"
     ax.set_title(title, fontsize="medium")
     return ax
 

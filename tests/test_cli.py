@@ -53,6 +53,23 @@ def test_info_reports_pga_of_the_readme_table(capsys):
         np.abs(raw.components["H2"]).max() / STANDARD_GRAVITY, abs=6e-5)
 
 
+def test_info_says_a_start_the_file_does_not_state_instead_of_printing_1970(capsys):
+    # a PEER AT2 file has no start time; its reader leaves obspy's epoch, which 'info' printed
+    # as if the record had started on 1970-01-01
+    from pathlib import Path
+
+    at2 = Path(__file__).parent / "data" / "helena_synthetic_180.AT2"
+    code, out, _ = run(capsys, "info", str(at2), "--processing", "none")
+    assert code == 0
+    start = next(line for line in out.splitlines() if line.startswith("start"))
+    assert "not stated in the file" in start and "1970-01-01T" not in start
+    # a record that states its start keeps it, to the sample
+    code, out, _ = run(capsys, "info", "--record", "NP.1759", "--processing", "none")
+    assert code == 0
+    start = next(line for line in out.splitlines() if line.startswith("start"))
+    assert start.split()[1].startswith("2014-08-24T10:20:")
+
+
 def test_process_writes_records_and_intensity_table(tmp_path, capsys):
     code, out, _ = run(capsys, "process", "--record", "NP.1743", "-o", str(tmp_path),
                        "--format", "SAC")

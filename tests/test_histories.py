@@ -208,6 +208,25 @@ def test_history_command_prints_writes_and_draws(history_run, tmp_path, capsys):
     assert code == 2 and "[im_level]" in err and "several runs" in err
 
 
+def test_a_level_or_swept_value_not_in_the_design_is_named_in_the_unit_it_was_given(
+        tmp_path, capsys):
+    # --im-level-g 0.65 used to be reported as "[im_level_g] 6.3743225 is not a value ...;
+    # values: 0.3, 0.6": the level in m/s^2 under the name in g, beside the values in g
+    path = write_pipeline(tmp_path, kind="msa", levels="levels_g = [0.3, 0.6]",
+                          sweep="[sweep]\nhalf_height = [0.5, 0.6]\n")
+    base = ["-q", "history", str(path), "--record", "S1"]
+    assert main([*base, "--im-level-g", "0.65", "--set", "half_height=0.5"]) == 2
+    err = capsys.readouterr().err
+    assert "[im_level_g] 0.65 g is not a value of the design; values: 0.3, 0.6 g" in err
+    assert main([*base, "--im-level", "3", "--set", "half_height=0.5"]) == 2
+    err = capsys.readouterr().err
+    assert (f"[im_level] 3.0 m/s^2 is not a value of the design; values: {0.3 * G:g}, "
+            f"{0.6 * G:g} m/s^2") in err
+    assert main([*base, "--im-level-g", "0.6", "--set", "half_height=0.55"]) == 2
+    err = capsys.readouterr().err
+    assert "[half_height] 0.55 m is not a value of the design; values: 0.5, 0.6 m" in err
+
+
 def test_top_level_export():
     assert shipblock.rerun_case is rerun_case
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import matplotlib
 import numpy as np
 import pytest
+import xarray as xr
 
 from shipblock.cli import main
 from shipblock.fragility.pipeline import run_pipeline
@@ -17,6 +18,7 @@ from shipblock.plot import (
     plot_median_sweep,
     study_caption,
     sweep_selection,
+    sweep_text,
 )
 from shipblock.units import STANDARD_GRAVITY as G
 
@@ -54,6 +56,29 @@ def test_the_command_line_prints_a_table_of_medians_per_swept_value(sweep_run, c
         else:
             assert "not fitted" in row
     assert fit_lines(ds) == study_report(ds)[-len(fit_lines(ds)):]
+
+
+def test_a_swept_length_is_printed_and_drawn_with_its_unit(tmp_path, capsys):
+    # a sweep over the blocks' half height: its values are metres, and the table's header,
+    # its "not fitted at" notes and the figure's title say so (they used to print a bare
+    # "half_height 0.5", read as anything from millimetres to feet)
+    path = write_pipeline(tmp_path, levels=LEVELS, sweep="[sweep]\nhalf_height = [0.5, 0.6]\n")
+    assert main(["-q", "run", str(path), "--figure", str(tmp_path / "f.png")]) == 0
+    out = capsys.readouterr().out
+    ds = xr.open_dataset(tmp_path / "out" / "result.nc")
+    assert ds["half_height"].attrs["units"] == "m"
+    table = out.split("  ship_slip:\n", 1)[1].splitlines()
+    assert table[0].split()[:2] == ["half_height", "[m]"]
+    for row, h in zip(table[1:3], (0.5, 0.6), strict=True):
+        assert float(row.split()[0]) == h
+    notes = [line for line in out.splitlines() if "not fitted at" in line]
+    assert all("half_height = 0.5 m" in n or "half_height = 0.6 m" in n for n in notes)
+    title = plot_fragility(ds).get_title(loc="left")
+    assert "drawn at half_height = 0.5 m" in title
+    # a dimensionless swept value stays bare
+    assert sweep_text({"mu_ship": 0.3}, ds.assign_coords(mu_ship=("mu_ship", [0.3],
+                                                                  {"units": "1"}))) \
+        == "mu_ship = 0.3"
 
 
 def test_sweep_selection_matches_values_and_names_the_choices(sweep_run):
@@ -156,6 +181,39 @@ def test_plot_command_draws_the_swept_value_asked_for_and_the_median_against_the
     line = ax.get_lines()[0]
     np.testing.assert_allclose(line.get_ydata(),
                                ds["median"].sel(limit_state="ship_slip").values / G)
+
+
+def test_plot_command_draws_the_limit_states_asked_for(sweep_run, tmp_path, capsys,
+                                                      monkeypatch):
+    # plot_fragility's and plot_median_sweep's limit_state existed only in Python
+    import shipblock.plot
+
+    tmp, _, ds = sweep_run
+    nc = tmp / "out" / "result.nc"
+    drawn = []
+    for name in ("plot_fragility", "plot_median_sweep"):
+        original = getattr(shipblock.plot, name)
+
+        def spy(*args, _original=original, **kw):
+            ax = _original(*args, **kw)
+            drawn.append([t.get_text().split(" (")[0] for t in ax.get_legend().get_texts()])
+            return ax
+
+        monkeypatch.setattr(shipblock.plot, name, spy)
+    names = [str(n) for n in ds["limit_state"].values]
+    assert len(names) >= 2
+    for kind in ("fragility", "median"):
+        assert main(["-q", "plot", str(nc), "--kind", kind, "--limit-state", names[1],
+                     "-o", str(tmp_path / f"{kind}.png")]) == 0
+        assert (tmp_path / f"{kind}.png").exists()
+    assert drawn == [[names[1]], [names[1]]]
+    assert main(["-q", "plot", str(nc), "--limit-state", "nope", "-o", str(tmp_path / "x.png")]) \
+        == 2
+    assert (f"--limit-state 'nope' is not a limit state of the study; limit states: "
+            f"{', '.join(names)}") in capsys.readouterr().err
+    assert main(["-q", "plot", str(nc), "--kind", "ida", "--limit-state", names[0], "-o",
+                 str(tmp_path / "x.png")]) == 2
+    assert "--limit-state draws with --kind fragility or median" in capsys.readouterr().err
 
 
 def test_cloud_figure_draws_each_records_outcome_at_its_intensity(tmp_path):

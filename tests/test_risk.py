@@ -413,6 +413,12 @@ def test_command_line_prints_writes_and_draws(study, tmp_path, capsys):
     assert main(["-q", "risk", results, "--hazard", str(SA1_CURVES), "--days", "120",
                  "--site", "Seattle WA", "-o", str(tmp_path / "x.nc")]) == 2
     assert "is a hazard curve for SA(1 s), but the study" in capsys.readouterr().err
+    # a file of several sites and no --site: the refusal names the flag and the sites
+    assert main(["-q", "risk", results, "--hazard", str(PGA_CURVES), "--days", "120",
+                 "-o", str(tmp_path / "y.nc")]) == 2
+    err = capsys.readouterr().err
+    assert "holds 4 sites; choose one with site (--site: a name or lon,lat)" in err
+    assert "Seattle WA (-122.3, 47.6)" in err
 
 
 def test_deaggregation_figure_shares_sum_to_100(study):

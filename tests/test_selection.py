@@ -205,6 +205,41 @@ def test_command_line_writes_the_selection(catalogue, tmp_path, capsys):
     assert "give the unit of Sa (units, --units)" in capsys.readouterr().err
 
 
+def test_command_line_takes_the_damping_ids_periods_and_suite_floor_of_the_python_api(
+        catalogue, tmp_path, capsys):
+    # a target at 2 % damping: the scaled copy a2 of H_A matches it exactly (factor 2, misfit
+    # 0) only when the records' spectra are taken at 2 % too; at the default 5 % the misfit
+    # is the shape difference of the two dampings, not 0 (a silent mismatch before --damping)
+    sa_2 = intensity.spectral_acceleration(H_A, DT, PERIODS, 0.02)
+    target = tmp_path / "target_2pct.csv"
+    target.write_text("period [s], Sa [m/s^2]\n" + "".join(
+        f"{float(p)!r}, {float(v)!r}\n" for p, v in zip(PERIODS, sa_2, strict=True)))
+    out = tmp_path / "selected.toml"
+    common = ["-q", "select", str(catalogue), "--target", str(target), "-k", "1", "-o", str(out),
+              "--no-processing", "--n-periods", str(PERIODS.size),
+              "--ids", "syn/a2", "syn/b1", "--ids", "syn/c1"]
+    assert main([*common, "--damping", "0.02", "--no-suite-floor"]) == 0
+    text = capsys.readouterr().out
+    assert "1 of 3 records chosen (H1 horizontal, 2 % damping, 0.1 to 2 s)" in text
+    row = next(line for line in text.splitlines() if "syn/a2" in line).split()
+    assert row[:3] == ["1", "syn/a2", "2.000"] and float(row[3]) < 5e-4
+    assert list(load_catalogue(out)) == ["syn/a2"]
+    python = select_records(catalogue, target, 1, processing=[], n_periods=PERIODS.size,
+                            ids=["syn/a2", "syn/b1", "syn/c1"], damping=0.02,
+                            suite_floor=False)
+    assert python.chosen[0].factor == pytest.approx(2.0, rel=1e-9)
+    assert python.chosen[0].misfit < 1e-9
+    assert main(common) == 0
+    text = capsys.readouterr().out
+    assert "5 % damping" in text
+    default = select_records(catalogue, target, 1, processing=[], n_periods=PERIODS.size,
+                             ids=["syn/a2", "syn/b1", "syn/c1"])
+    assert default.chosen[0].misfit > 1e-3
+    # a percentage given for the fraction is refused, naming it
+    assert main([*common, "--damping", "5"]) == 2
+    assert "damping must be a number in [0, 1), got 5.0" in capsys.readouterr().err
+
+
 def test_azimuth_of_a_north_component_gives_its_spectrum_and_east_its_other():
     # the shipped South Napa records: HNN at 0 deg, HNE at 90 deg (StationXML); rotated onto
     # azimuth 0 the horizontal is H1, onto 90 deg it is H2
@@ -273,9 +308,9 @@ def test_at_most_n_records_per_earthquake_changes_the_suite_to_the_best_within_t
 
 def test_a_cap_the_catalogue_cannot_meet_and_an_unknown_earthquake_are_refused(
         event_catalogue, catalogue):
-    with pytest.raises(ParameterError, match=r"max_per_event = 1: the 5 matched records come "
-                                             r"from 3 earthquake\(s\), so at most 3 can be "
-                                             r"chosen, not k = 4"):
+    with pytest.raises(ParameterError, match=r"max_per_event = 1 \(--max-per-event\): the 5 "
+                                             r"matched records come from 3 earthquake\(s\), so "
+                                             r"at most 3 can be chosen, not k = 4 \(-k\)"):
         select(event_catalogue, 4, scale=False, max_per_event=1)
     with pytest.raises(ParameterError, match="max_per_event"):
         select(event_catalogue, 2, max_per_event=0)
@@ -319,3 +354,8 @@ def test_command_line_caps_records_per_earthquake(event_catalogue, tmp_path, cap
     assert list(back) == ["syn/r1", "syn/r4", "syn/r5"]
     assert [back[i].extra["selection_event"] for i in back] == ["smi:local/event/A", "B", "C"]
     assert "# At most 1 record(s) per earthquake" in out.read_text()
+    # the refusal names the flags a command-line user gave, not only the Python keywords
+    assert main(["-q", "select", str(event_catalogue), "--target", str(target), "-k", "4",
+                 "--no-scale", "--no-processing", "--max-per-event", "1", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "max_per_event = 1 (--max-per-event)" in err and "not k = 4 (-k)" in err

@@ -145,6 +145,9 @@ def build_parser():
     s.add_argument("--against", metavar="NAME",
                    help="with --kind median: the swept parameter on the x axis (default: the "
                         "first)")
+    s.add_argument("--limit-state", action="append", metavar="NAME",
+                   help="with --kind fragility or median: draw only this limit state "
+                        "(repeatable; default: all)")
     s.set_defaults(func=cmd_plot)
 
     s = sub.add_parser("risk", help="risk over a docking period: fragility x site hazard",
@@ -203,6 +206,17 @@ def build_parser():
     s.add_argument("--max-scale-factor", type=float, default=4.0, help="default 4")
     s.add_argument("--no-processing", action="store_true",
                    help="spectra of the records as read (default: the default processing chain)")
+    s.add_argument("--ids", nargs="+", action="extend", metavar="ID",
+                   help="only these catalogue records (default: all), e.g. --ids NP.1765 "
+                        "NP.1764")
+    s.add_argument("--damping", type=float, default=0.05, metavar="ZETA",
+                   help="fraction of critical damping of the records' spectra, as the "
+                        "target's [-] (default 0.05, i.e. 5 %%; not a percentage)")
+    s.add_argument("--n-periods", type=int, default=30, metavar="N",
+                   help="periods compared, log-spaced over the range (default 30)")
+    s.add_argument("--no-suite-floor", action="store_true",
+                   help="do not raise the suite's factors to meet the ASCE 7-16 90 %% floor "
+                        "(default: raise them)")
     s.add_argument("--max-per-event", type=int, metavar="N",
                    help="at most N records from one earthquake (FEMA P-695 takes 2); the "
                         "earthquake from the catalogue's event_id, else the QuakeML event, the "

@@ -25,7 +25,10 @@ def cmd_info(args):
     out.write(f"record      {motion.name} {site}\n")
     for f in md.get("source_files", []):
         out.write(f"file        {f}\n")
-    out.write(f"start       {motion.starttime}\n")
+    # formats without a start time (PEER AT2, one-column text) leave obspy's epoch: not a time
+    start = motion.starttime
+    out.write(f"start       {start}\n" if start.year > 1970 else
+              "start       not stated in the file (its reader's placeholder: 1970-01-01)\n")
     out.write(f"sampling    dt = {motion.dt:g} s ({1 / motion.dt:g} Hz), {motion.npts} samples, "
               f"{motion.npts * motion.dt:.2f} s\n")
     units = md.get("units")

@@ -44,7 +44,9 @@ def cmd_select(args):
         vertical_weight=args.vertical_weight, scale=not args.no_scale,
         min_scale_factor=args.min_scale_factor, max_scale_factor=args.max_scale_factor,
         horizontal=args.horizontal, azimuth=args.azimuth,
-        processing=[] if args.no_processing else None, max_per_event=args.max_per_event)
+        processing=[] if args.no_processing else None, max_per_event=args.max_per_event,
+        damping=args.damping, n_periods=args.n_periods, ids=args.ids,
+        suite_floor=not args.no_suite_floor)
     output = Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     partial = output.with_name(output.name + ".part")

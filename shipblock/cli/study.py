@@ -130,6 +130,16 @@ def cmd_plot(args):
         sweep = sweep_selection(ds, _parse_assignments(args.set))
     except ValueError as exc:
         raise UserError(f"{args.results}: --set {exc}") from None
+    limit_states = args.limit_state
+    if limit_states:
+        if args.kind == "ida":
+            raise UserError(f"{args.results}: --limit-state draws with --kind fragility or "
+                            "median; IDA curves draw an --edp")
+        known = [str(n) for n in ds["limit_state"].values]
+        unknown = [n for n in limit_states if n not in known]
+        if unknown:
+            raise UserError(f"{args.results}: --limit-state {unknown[0]!r} is not a limit state "
+                            f"of the study; limit states: {', '.join(known)}")
     if args.kind == "ida":
         edp = default_edp(ds) if args.edp is None else args.edp
         try:
@@ -144,9 +154,10 @@ def cmd_plot(args):
         if against not in sweep:
             raise UserError(f"{args.results}: --against {against!r} is not a swept parameter; "
                             f"swept: {', '.join(sweep)}")
-        _save_figure(lambda: plot_median_sweep(ds, against, sweep=sweep).figure, figure)
+        _save_figure(lambda: plot_median_sweep(ds, against, limit_states,
+                                                        sweep=sweep).figure, figure)
     else:
-        _save_figure(lambda: plot_fragility(ds, sweep=sweep).figure, figure)
+        _save_figure(lambda: plot_fragility(ds, limit_states, sweep=sweep).figure, figure)
     sys.stdout.write(f"figure written to {figure}\n")
     return 0
 

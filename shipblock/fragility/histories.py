@@ -78,7 +78,9 @@ def _record_index(design: AnalysisDesign, record) -> int:
                                    f"{', '.join(design.records)}")
 
 
-def _value_index(values, wanted, key: str, shown) -> int:
+def _value_index(values, wanted, key: str, shown, *, given=None, units: str = "") -> int:
+    """Index of ``wanted`` in ``values``; the error shows ``given`` (the value as the user gave
+    it, default ``wanted``) and ``shown`` (the values in the user's unit ``units``)."""
     if len(values) and all(isinstance(v, str) for v in values):  # a string dimension: names
         if wanted in values:
             return list(values).index(wanted)
@@ -89,8 +91,10 @@ def _value_index(values, wanted, key: str, shown) -> int:
     values = np.asarray(values, dtype=float)
     close = np.flatnonzero(np.isclose(values, float(wanted), rtol=MATCH_RTOL, atol=0.0))
     if close.size != 1:
-        raise SelectionError(key, f"{wanted!r} is not a value of the design; values: "
-                                  f"{', '.join(f'{v:g}' for v in shown)}")
+        unit = "" if units in ("", "1") else f" {units}"
+        raise SelectionError(key, f"{wanted if given is None else given!r}{unit} is not a value "
+                                  f"of the design; values: "
+                                  f"{', '.join(f'{v:g}' for v in shown)}{unit}")
     return int(close[0])
 
 
@@ -111,19 +115,23 @@ def _selected_indices(design: AnalysisDesign, selector: Mapping) -> list[list[in
     if "im_level" in selector and "im_level_g" in selector:
         raise SelectionError("im_level_g", "give im_level or im_level_g, not both")
     if "im_level" in selector:
-        picks.append([_value_index(levels, selector["im_level"], "im_level", levels)])
+        picks.append([_value_index(levels, selector["im_level"], "im_level", levels,
+                                   units=intensity.units)])
     elif "im_level_g" in selector:
         if intensity.measure == "pgv":
             raise SelectionError("im_level_g", "PGV levels are velocities: use im_level [m/s]")
-        wanted = selector["im_level_g"]
+        given = wanted = selector["im_level_g"]
         if isinstance(wanted, int | float) and not isinstance(wanted, bool):
             wanted = wanted * STANDARD_GRAVITY
-        picks.append([_value_index(levels, wanted, "im_level_g", levels / STANDARD_GRAVITY)])
+        # the error shows the level in g as given, not its value in m/s^2
+        picks.append([_value_index(levels, wanted, "im_level_g", levels / STANDARD_GRAVITY,
+                                   given=given, units="g")])
     else:
         picks.append(list(range(intensity.n_levels)))
     for name, values in design.sweep:
         if name in selector:
-            picks.append([_value_index(values, selector[name], name, values)])
+            picks.append([_value_index(values, selector[name], name, values,
+                                       units=design.model.sweep_parameters[name][0])])
         else:
             picks.append(list(range(len(values))))
     return picks

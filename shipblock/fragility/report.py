@@ -61,6 +61,25 @@ def _sweep_dims(da: xr.DataArray) -> list[str]:
     return [d for d in da.dims if d not in _GRID_DIMS]
 
 
+def swept_unit(ds: xr.Dataset, name: str) -> str:
+    """The unit of a swept parameter's coordinate, ``""`` when it has none (or is ``"1"``).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A result of a sweep.
+    name : str
+        The swept parameter, e.g. ``"side_offset"``.
+
+    Returns
+    -------
+    str
+        e.g. ``"m"`` for a side line's distance; ``""`` for a friction coefficient.
+    """
+    units = str(ds[name].attrs.get("units", "")) if name in ds.coords else ""
+    return "" if units in ("", "1") else units
+
+
 def _median_text(ds, sel, factor) -> tuple[str, str]:
     median = float(ds["median"].sel(sel)) / factor
     band = ""
@@ -113,7 +132,9 @@ def fit_lines(ds: xr.Dataset) -> list[str]:
                 lines.append(f"  {'':<24} ({error})")
             continue
         lines.append(f"  {name}:")
-        header = [*sweep, "median", "band", "beta"]
+        units = [swept_unit(ds, d) for d in sweep]
+        header = [f"{d} [{u}]" if u else d for d, u in zip(sweep, units, strict=True)]
+        header += ["median", "band", "beta"]
         rows = []
         notes = []
         for combo in itertools.product(*(ds[d].values for d in sweep)):
@@ -124,8 +145,9 @@ def fit_lines(ds: xr.Dataset) -> list[str]:
             if median == "nan":
                 error = str(ds["fit_error"].sel(sel).values) if "fit_error" in ds else ""
                 rows.append([*values, "not fitted", "", ""])
-                notes.append(f"{', '.join(f'{d} = {v}' for d, v in zip(sweep, values, strict=True))}"
-                             f": {error.split(': ', 1)[-1]}")
+                where = ", ".join(f"{d} = {v}{f' {u}' if u else ''}"
+                                  for d, v, u in zip(sweep, values, units, strict=True))
+                notes.append(f"{where}: {error.split(': ', 1)[-1]}")
             else:
                 rows.append([*values, median, band, f"{float(ds['beta'].sel(sel)):.3f}"])
         widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]

@@ -11,7 +11,7 @@ from pathlib import PurePath
 import numpy as np
 
 from shipblock.errors import ParameterError
-from shipblock.fragility.report import display_units, im_label
+from shipblock.fragility.report import display_units, im_label, swept_unit
 from shipblock.fragility.store import dataset_model
 from shipblock.models import DEFAULT_MODEL, get_model
 from shipblock.plot._common import _new_axes, _title
@@ -152,10 +152,18 @@ def _select_sweep(da, sweep):
     return da
 
 
-def sweep_text(sweep) -> str:
-    """``"mu_ground = 0.5, n_blocks = 100"``: the swept values drawn, for titles."""
-    return ", ".join(f"{k} = {v:g}" if isinstance(v, float | int | np.number) else f"{k} = {v}"
-                     for k, v in (sweep or {}).items())
+def sweep_text(sweep, ds=None) -> str:
+    """``"mu_ground = 0.5, side_offset = 3 m"``: the swept values drawn, for titles.
+
+    With the result ``ds``, each value carries the unit of its coordinate (none for a
+    dimensionless one), so that a title never shows a length without its unit.
+    """
+    def one(k, v):
+        text = f"{k} = {v:g}" if isinstance(v, float | int | np.number) else f"{k} = {v}"
+        unit = swept_unit(ds, k) if ds is not None else ""
+        return f"{text} {unit}" if unit else text
+
+    return ", ".join(one(k, v) for k, v in (sweep or {}).items())
 
 
 _CONDITION_SYMBOLS = {"greater": ">", "greater_equal": ">=", "equal": "=", "nonzero": "!= 0"}
@@ -306,7 +314,7 @@ def plot_fragility(ds, limit_state=None, ax=None, sweep=None):
         curves += ("; shaded: " + (f"{100 * float(conf):g} % " if conf is not None else "")
                    + "bootstrap band of the median")
     if sweep:
-        curves += f"; drawn at {sweep_text(sweep)}"
+        curves += f"; drawn at {sweep_text(sweep, ds)}"
     what = [curves]
     if n_per_level is not None:
         counts = np.unique(n_per_level)
@@ -386,7 +394,9 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
         missing = [str(v) if categorical else f"{v:g}"
                    for v, m in zip(values, med, strict=True) if not np.isfinite(m)]
         if missing:
-            label += f"; not fitted at {parameter} = {', '.join(missing)}"
+            unit = swept_unit(ds, parameter)
+            label += (f"; not fitted at {parameter} = {', '.join(missing)}"
+                      + (f" {unit}" if unit and not categorical else ""))
         # names have no order between them: no line joins their medians
         ax.plot(xd, med, ("" if categorical else "-") + _MARKERS[i % len(_MARKERS)], color=c,
                 lw=1.5, ms=5,
@@ -418,7 +428,7 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
         what += (f"; limit states side by side, {100 * DODGE:g} % of the "
                  + ("span of the names" if categorical else f"{parameter} range") + " apart")
     if others:
-        what += f"; drawn at {sweep_text(others)}"
+        what += f"; drawn at {sweep_text(others, ds)}"
     # the system line holds the base value of the parameter on the x axis: say it is swept
     caption = [line + (f"; {parameter} swept (x axis)" if line.startswith("system: ") else "")
                for line in study_caption(ds, others)]
@@ -518,7 +528,7 @@ def plot_ida(ds, edp=None, ax=None, sweep=None):
             f"intensity it was scaled to; x: a failed run ({failures_text(ds)}), drawn at the "
             f"right edge")
     if sweep:
-        what += f"; drawn at {sweep_text(sweep)}"
+        what += f"; drawn at {sweep_text(sweep, ds)}"
     _title(ax, study_caption(ds, sweep), [what])
     ax.legend(fontsize=8, ncol=2)
     return ax

@@ -506,7 +506,7 @@ def _fragility_section(ds) -> list:
     sweep = sweep_selection(ds)
     for combo in _arrangements(ds):
         out.append(Figure(lambda combo=combo: plot_fragility(ds, sweep=combo).figure,
-                          "fragility curves" + (f" at {sweep_text(combo)}" if combo else "")))
+                          "fragility curves" + (f" at {sweep_text(combo, ds)}" if combo else "")))
     for dim in sweep:
         out.append(Figure(lambda dim=dim: plot_median_sweep(ds, dim, sweep=sweep).figure,
                           f"median against {dim}"))
@@ -520,7 +520,7 @@ def _risk_figure(ds, selection, days):
     # the figure's title with the study, system and design, as the study figures have
     fig.suptitle(_wrapped([*study_caption(ds, selection),
                            f"risk over a docking period of {days:g} days"
-                           + (f", drawn at {sweep_text(selection)}" if selection else "")],
+                           + (f", drawn at {sweep_text(selection, ds)}" if selection else "")],
                           fig.get_figwidth()), fontsize=8.5, x=0.01, ha="left")
     return fig
 
@@ -557,7 +557,7 @@ def _risk_section(ds) -> list:
                  f"No bootstrap band ({ds.attrs.get('risk_band', '')}).")),
            Preformatted(risk_lines(ds)[0]), _t(header, rows)]
     for selection in _arrangements(ds):
-        where = f" at {sweep_text(selection)}" if selection else ""
+        where = f" at {sweep_text(selection, ds)}" if selection else ""
         if not np.isfinite(ds[RISK].sel(selection).values).any():
             out.append(_p(f"No figure{where}: no limit state was fitted there."))
             continue

@@ -206,8 +206,8 @@ def _select_site(sites: list[tuple[str, float, float]], site, source) -> int:
     if site is None:
         if len(sites) == 1:
             return 0
-        raise HazardError(source, f"holds {len(sites)} sites; choose one with site (a name or "
-                                  f"lon,lat): {shown}")
+        raise HazardError(source, f"holds {len(sites)} sites; choose one with site (--site: a "
+                                  f"name or lon,lat): {shown}")
     if isinstance(site, str) and "," in site and not any(n == site for n, _, _ in sites):
         try:
             site = tuple(float(v) for v in site.split(","))

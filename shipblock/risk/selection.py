@@ -490,9 +490,9 @@ def _capped(ranked, k, max_per_event):
             break
     if len(chosen) < k:
         events = len({m.event for m in ranked})
-        raise ParameterError(f"max_per_event = {max_per_event}: the {len(ranked)} matched records "
-                             f"come from {events} earthquake(s), so at most {len(chosen)} can be "
-                             f"chosen, not k = {k}")
+        raise ParameterError(f"max_per_event = {max_per_event} (--max-per-event): the "
+                             f"{len(ranked)} matched records come from {events} earthquake(s), so "
+                             f"at most {len(chosen)} can be chosen, not k = {k} (-k)")
     return chosen, left_out
 
 
@@ -586,7 +586,8 @@ def selection_lines(selection: Selection) -> list[str]:
     o = selection.options
     lines = [f"{len(selection.chosen)} of {len(selection.ranked)} records chosen "
              f"({o['horizontal']} horizontal"
-             + (", with the vertical" if o["vertical_target"] else "") + f", "
+             + (", with the vertical" if o["vertical_target"] else "")
+             + f", {100 * o['damping']:g} % damping, "
              f"{o['period_range_s'][0]:g} to {o['period_range_s'][1]:g} s)"]
     header = f"  {'rank':>4}  {'record':<32} {'factor':>8} {'misfit':>8} {'misfit H':>9}"
     if o["vertical_target"]:
@@ -609,7 +610,7 @@ def selection_lines(selection: Selection) -> list[str]:
         lines.append(f"suite factor {selection.suite_factor:.4g} applied to reach the 90 % floor")
     if not selection.passes and o["scale"]:
         lines.append(f"the factors cannot rise further: max_scale_factor = "
-                     f"{o['max_scale_factor']:g} (or choose other records)")
+                     f"{o['max_scale_factor']:g} (--max-scale-factor; or choose other records)")
     lines.append(f"suite mean / target: lowest {selection.suite_ratio_min:.3f} at "
                  f"{selection.suite_ratio_period:.3g} s: ASCE 7-16 §16.2.3 90 % check "
                  f"{'passed' if selection.passes else 'FAILED'}")
