@@ -9,6 +9,7 @@ import json
 from pathlib import PurePath
 
 import numpy as np
+from matplotlib.transforms import ScaledTranslation
 
 from shipblock.errors import ParameterError
 from shipblock.fragility.report import display_units, im_label, swept_unit
@@ -433,7 +434,11 @@ def plot_median_sweep(ds, parameter=None, limit_state=None, ax=None, sweep=None)
     caption = [line + (f"; {parameter} swept (x axis)" if line.startswith("system: ") else "")
                for line in study_caption(ds, others)]
     _title(ax, caption, [what])
-    ax.legend(fontsize=7.5)
+    # under the axes: inside, the long labels of several limit states cover their markers
+    # (half an inch below the axes' bottom, clear of the tick labels and the axis label)
+    below = ax.transAxes + ScaledTranslation(0.0, -0.5, ax.figure.dpi_scale_trans)
+    ax.legend(fontsize=7.5, loc="upper center", bbox_to_anchor=(0.5, 0.0),
+              bbox_transform=below, ncol=2, borderaxespad=0.0)
     return ax
 
 
