@@ -129,7 +129,7 @@ def study(tmp_path_factory):
     return tmp, path, run_pipeline(path, progress=False)
 
 
-def KNOWN_CHATTER_RUN(ds):
+def known_chatter_run(ds):
     """The run of the study that shows the open event-sequence defect (issue 29)."""
     # record syn/S0 at the highest level (1.5 g) with mu_top = 0.3
     return ((ds["record"] == "syn/S0") & (ds["im_level"] == ds["im_level"].max())
@@ -145,7 +145,7 @@ def KNOWN_CHATTER_RUN(ds):
     "in the last bits on another processor; an XPASS in the report says to look again."))
 def test_the_stick_slip_chatter_run_balances_its_energy(study):
     _, _, ds = study
-    residual = ds["energy_residual"].where(KNOWN_CHATTER_RUN(ds), drop=True)
+    residual = ds["energy_residual"].where(known_chatter_run(ds), drop=True)
     assert residual.size == 1
     assert abs(float(residual.values.ravel()[0])) < 1e-3
 
@@ -167,7 +167,7 @@ def test_a_section_study_runs_the_section_model(study):
     assert (failure == 0).any() and (failure == 4).any()
     # every run balances its energy (or stopped at a failure with its balance so far), but for
     # the known defect of test_the_stick_slip_chatter_run_balances_its_energy
-    residual = np.abs(ds["energy_residual"]).where(~KNOWN_CHATTER_RUN(ds))
+    residual = np.abs(ds["energy_residual"]).where(~known_chatter_run(ds))
     assert float(residual.max()) < 1e-3
     # each failure kind's boolean EDP is its code
     for name, code in FAILURE_FLAGS.items():
