@@ -271,7 +271,9 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
         first = -1
         lo, hi = 0.0, 1.0
         for q in range(ng):
-            if g0[q] > 0.0 and g1[q] <= 0.0:
+            # a cap that has just let go starts at a gap of exactly 0 (its surface is where the
+            # body left it): a step that ends with the body back in it has met it again
+            if g1[q] <= 0.0 and (g0[q] > 0.0 or (g0[q] == 0.0 and _is_gap(q, nsp, reg))):
                 a, b, ga, gb = 0.0, 1.0, g0[q], g1[q]
                 if first >= 0:
                     # only look before the earliest one found so far
@@ -490,6 +492,12 @@ def _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, 
         return EV_OVERTURN, q - o + 1
     kinds = (EV_SLID_OFF, EV_TIP, EV_SEPARATION, EV_INVALID)
     return kinds[q - o - nb + 1], -1
+
+
+@njit(cache=True, inline="always")
+def _is_gap(q, nsp, reg):
+    """Whether event function ``q`` is the gap of a spring that is not carrying."""
+    return q < 2 * nsp and q % 2 == 0 and reg[q // 2] == R_FREE
 
 
 @njit(cache=True, inline="always")
