@@ -12,8 +12,9 @@ at the centre of pressure of their forces (:func:`friction_offset`; the face cen
 strip carries nothing). :mod:`shipblock.section.model` explains every law; this module only
 evaluates them.
 
-State vector: ``q`` (3 per body), ``v`` (3 per body), ``u`` (stick-spring extension per strip),
-then the running integrals ``W_ground, W_wind, D_damping, D_friction`` (not error-controlled).
+State vector: ``q`` (3 per body), ``v`` (3 per body), ``u`` (per strip: the stick spring's
+extension while it sticks; while it slips, the energy it has lost since the slip began, which
+bounds the next stick's preload), then the running integrals ``W_ground, W_wind, D_damping, D_friction`` (not error-controlled).
 
 numba's cache of :func:`shipblock.section._kernel.run` holds these functions compiled in, and it
 is keyed on ``_kernel.py`` only: after editing this module, touch ``_kernel.py`` (or clear its
@@ -244,8 +245,8 @@ def _strip_load(x, nb, j, strip_f, fs, cb, sb, ny, nz, l0, p0, total, moment, dc
         xdot[o_u + j] = 0.0
     else:
         ft = -fs[j] * strip_f[j, SF_MUK] * total
-        xdot[o_u + j] = 0.0
         d_fric = -ft * vtj
+        xdot[o_u + j] = d_fric  # the energy the face has lost since its slip began
     # normal force total n and tangential ft t (t = (n_z, -n_y)) on C, the opposite on S
     fy_ = total * ny + ft * nz
     fz_ = total * nz - ft * ny

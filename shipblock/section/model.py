@@ -44,8 +44,10 @@ cap's ``shear_ratio`` times ``k_strip``, ``c_t = 2 zeta sqrt(k_t m_eff)``), with
 integral since the last stick point of ``v_t``, the relative tangential velocity of C's material
 point at the centre of pressure (the force acts where its rate is taken: the energy balance is
 exact; at rest ``u`` is the displacement of the face centre, see *Initial state*); slip when ``|F_t|`` reaches ``mu_s N``, then
-``F_t = -mu_k N sign(v_t)``; stick again, with ``u = 0``, when ``v_t`` changes sign. The stick
-spring's energy at a slip onset is counted as friction loss.
+``F_t = -mu_k N sign(v_t)``; stick again when ``v_t`` changes sign, the stick spring preloaded
+to ``mu_k N`` (the force continuous) but to no more energy than the face has lost since its
+slip began (a slip-stick cycle cannot create energy). The stick spring's energy at a slip onset
+is counted as friction loss, a preload's against it.
 
 Initial state
 -------------
