@@ -40,7 +40,6 @@ Run: ``python tests/tools/section_wmethod.py`` (prints the table of
 from __future__ import annotations
 
 import math
-import sys
 import time
 
 import numpy as np
@@ -56,29 +55,67 @@ from shipblock.section.model import assemble, static_state
 from shipblock.section.simulate import (DEFAULT_SEPARATION_HEIGHT, _result, energy_terms,
                                         simulate_section)
 
-# --- ROS34PW2 (Rang and Angermann 2005, table of ROS34PW2), transformed to (a, c, m) ---------
-GAMMA = 0.43586652150845900
-_GAM = np.array([[GAMMA, 0.0, 0.0, 0.0],
-                 [-0.87173304301691801, GAMMA, 0.0, 0.0],
-                 [-0.90338057013044082, 0.054180672388095326, GAMMA, 0.0],
-                 [0.24212380706095346, -1.2232505839045147, 0.54526025533510214, GAMMA]])
-_ALPHA = np.array([[0.0, 0.0, 0.0, 0.0],
-                   [0.87173304301691801, 0.0, 0.0, 0.0],
-                   [0.84457060015369423, -0.11299064236484185, 0.0, 0.0],
-                   [0.0, 0.0, 1.0, 0.0]])
-_B = np.array([0.24212380706095346, -1.2232505839045147, 1.5452602553351020, GAMMA])
-_BHAT = np.array([0.37810903145819369, -0.096042292212423178, 0.5, 0.21793326075422950])
-_GI = np.linalg.inv(_GAM)
-_AT = np.tril(_ALPHA @ _GI, -1)
-_CT = np.tril(np.diag(1.0 / np.diag(_GAM)) - _GI, -1)
-_M = _B @ _GI
-_ME = (_B - _BHAT) @ _GI  # the error estimate: order 3 minus order 2
-_C = _ALPHA.sum(axis=1)  # stage times
-A21, A31, A32, A41, A42, A43 = _AT[1, 0], _AT[2, 0], _AT[2, 1], _AT[3, 0], _AT[3, 1], _AT[3, 2]
-C21, C31, C32, C41, C42, C43 = _CT[1, 0], _CT[2, 0], _CT[2, 1], _CT[3, 0], _CT[3, 1], _CT[3, 2]
-M1, M2, M3, M4 = _M
-E1, E2, E3, E4 = _ME
-T2, T3, T4 = _C[1], _C[2], _C[3]
+# --- the methods, in the transformed form (a, c, m, e, stage times, gamma, error exponent) -----
+
+
+def _transformed(gam, alpha, b, bhat, order_est):
+    """``(a, c, m, e, stage times, sums of Gamma's rows, gamma, 1 / (order_est + 1))`` from a
+    method's ``Gamma``, ``alpha``, ``b`` and embedded ``bhat`` (Hairer and Wanner 1996, IV.7,
+    eq. 7.25)."""
+    gi = np.linalg.inv(gam)
+    return (np.tril(alpha @ gi, -1), np.tril(np.diag(1.0 / np.diag(gam)) - gi, -1), b @ gi,
+            (b - bhat) @ gi, alpha.sum(axis=1), gam.sum(axis=1), float(gam[0, 0]),
+            1.0 / (order_est + 1.0))
+
+
+def _tableaus():
+    # ROS34PW2 (Rang and Angermann 2005): order 3 (also as a W-method), embedded 2, L-stable,
+    # stiffly accurate
+    g = 0.43586652150845900
+    pw2 = _transformed(
+        np.array([[g, 0.0, 0.0, 0.0], [-0.87173304301691801, g, 0.0, 0.0],
+                  [-0.90338057013044082, 0.054180672388095326, g, 0.0],
+                  [0.24212380706095346, -1.2232505839045147, 0.54526025533510214, g]]),
+        np.array([[0.0, 0.0, 0.0, 0.0], [0.87173304301691801, 0.0, 0.0, 0.0],
+                  [0.84457060015369423, -0.11299064236484185, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]]),
+        np.array([0.24212380706095346, -1.2232505839045147, 1.5452602553351020, g]),
+        np.array([0.37810903145819369, -0.096042292212423178, 0.5, 0.21793326075422950]), 2)
+    # ROS34PW3 (same paper): order 4 with the exact Jacobian, 3 as a W-method, embedded 3,
+    # A-stable
+    g = 1.0685790213016289
+    pw3 = _transformed(
+        np.array([[g, 0.0, 0.0, 0.0], [-2.5155456020628817, g, 0.0, 0.0],
+                  [-0.87991339217106512, -0.96014187766190695, g, 0.0],
+                  [-0.41731389379448741, 0.41091047035857703, -1.3558873204765276, g]]),
+        np.array([[0.0, 0.0, 0.0, 0.0], [2.5155456020628817, 0.0, 0.0, 0.0],
+                  [0.50777280103144085, 0.75, 0.0, 0.0],
+                  [0.13959081404277204, -0.33111001065419338, 0.82040559712714178, 0.0]]),
+        np.array([0.22047681286931747, 0.0027828278331185935, 0.0071844787635140066,
+                  0.76955588053404989]),
+        np.array([0.31300297285209688, -0.28946895245112692, 0.97646597959903003, 0.0]), 3)
+    # RODAS4 (Hairer and Wanner 1996, VI.4): order 4 with the exact Jacobian (not a W-method),
+    # embedded 3, L-stable, stiffly accurate; given in the transformed form
+    a = np.zeros((6, 6))
+    c = np.zeros((6, 6))
+    a[1, 0] = 1.544
+    a[2, :2] = 0.9466785280815826, 0.2557011698983284
+    a[3, :3] = 3.314825187068521, 2.896124015972201, 0.9986419139977817
+    a[4, :4] = 1.221224509226641, 6.019134481288629, 12.53708332932087, -0.687886036105895
+    a[5, :5] = 1.221224509226641, 6.019134481288629, 12.53708332932087, -0.687886036105895, 1.0
+    c[1, 0] = -5.6688
+    c[2, :2] = -2.430093356833875, -0.2063599157091915
+    c[3, :3] = -0.1073529058151375, -9.594562251023355, -20.47028614809616
+    c[4, :4] = 7.496443313967647, -10.24680431464352, -33.99990352819905, 11.7089089320616
+    c[5, :5] = (8.083246795921522, -7.981132988064893, -31.52159432874371, 16.31930543123136,
+                -6.058818238834054)
+    rodas4 = (a, c, np.array([*a[4, :4], 1.0, 1.0]), np.array([0.0, 0.0, 0.0, 0.0, 0.0, 1.0]),
+              np.array([0.0, 0.386, 0.21, 0.63, 1.0, 1.0]),
+              np.array([0.25, -0.1043, 0.1035, -0.0362, 0.0, 0.0]), 0.25, 0.25)
+    return {"ROS34PW2": pw2, "ROS34PW3": pw3, "RODAS4": rodas4}
+
+
+#: name -> (a, c, m, e, stage times, sums of Gamma's rows, gamma, error exponent)
+TABLEAUS = _tableaus()
 
 
 def jacobian_groups(asm, kind="lines"):
@@ -107,9 +144,11 @@ def jacobian_groups(asm, kind="lines"):
 
 @njit(cache=True)
 def _jacobian(t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y, ag_z,
-              dt_rec, sums, gidx, gsize, gcol, jac, xp, fp):
-    """Forward differences of :func:`stage_rhs` (the current regimes) for every group's block;
-    ``f0`` is ``stage_rhs`` at ``x``. Returns the number of evaluations."""
+              dt_rec, sums, gidx, gsize, gcol, jac, jace, xp, fp):
+    """Forward differences of :func:`stage_rhs` (the current regimes) for every group's block,
+    and in ``jace`` the energy integrals' rows (used with the full Jacobian only); ``f0`` is
+    ``stage_rhs`` at ``x``. Returns the number of evaluations."""
+    o_e = 6 * nb + ns
     n_eval = 0
     for colour in range(gcol.max() + 1):
         width = 0
@@ -132,62 +171,112 @@ def _jacobian(t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, o
                     e = xp[m] - x[m]
                     for r in range(gsize[g]):
                         jac[g, r, p] = (fp[gidx[g, r]] - f0[gidx[g, r]]) / e
+                    for r in range(jace.shape[0]):
+                        jace[r, m] = (fp[o_e + r] - f0[o_e + r]) / e
     return n_eval
 
 
 @njit(cache=True)
-def _factor(h, jac, gsize, lu, piv):
-    """LU (partial pivoting) of ``I / (h gamma) - J`` of every group."""
-    d = 1.0 / (h * GAMMA)
+def _lu(a, n, piv):
+    """LU factorisation with partial pivoting of ``a[:n, :n]``, in place."""
+    for k in range(n):
+        p = k
+        for r in range(k + 1, n):
+            if abs(a[r, k]) > abs(a[p, k]):
+                p = r
+        piv[k] = p
+        if p != k:
+            for c in range(n):
+                a[k, c], a[p, c] = a[p, c], a[k, c]
+        inv = 1.0 / a[k, k]
+        for r in range(k + 1, n):
+            a[r, k] *= inv
+            f = a[r, k]
+            if f != 0.0:
+                for c in range(k + 1, n):
+                    a[r, c] -= f * a[k, c]
+
+
+@njit(cache=True)
+def _lu_solve(a, n, piv, z):
+    """Solve with the factors of :func:`_lu`, ``z`` in place."""
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            z[k], z[p] = z[p], z[k]
+    for r in range(n):
+        s = z[r]
+        for c in range(r):
+            s -= a[r, c] * z[c]
+        z[r] = s
+    for r in range(n - 1, -1, -1):
+        s = z[r]
+        for c in range(r + 1, n):
+            s -= a[r, c] * z[c]
+        z[r] = s / a[r, r]
+
+
+@njit(cache=True)
+def _factor(h, gamma, jac, gsize, lu, piv, nq, reduced):
+    """Factorise ``I / (h gamma) - J`` of every group; with ``reduced`` (one group of all the
+    mechanical states, positions first: ``q' = v`` exactly) only its Schur complement on the
+    velocities and stick springs ``z``: ``I / (h gamma) - J_zz - h gamma J_zq P`` (``P`` takes
+    a velocity to its position), since the position rows give ``U_q = h gamma (b_q + U_v)``."""
+    d = 1.0 / (h * gamma)
+    if reduced:
+        hg = h * gamma
+        nz = gsize[0] - nq
+        for r in range(nz):
+            for c in range(nz):
+                v = jac[0, nq + r, nq + c]
+                if c < nq:
+                    v += hg * jac[0, nq + r, c]
+                lu[0, r, c] = -v
+            lu[0, r, r] += d
+        _lu(lu[0], nz, piv[0])
+        return
     for g in range(jac.shape[0]):
         n = gsize[g]
         for r in range(n):
             for c in range(n):
                 lu[g, r, c] = -jac[g, r, c]
             lu[g, r, r] += d
-        for k in range(n):
-            p = k
-            for r in range(k + 1, n):
-                if abs(lu[g, r, k]) > abs(lu[g, p, k]):
-                    p = r
-            piv[g, k] = p
-            if p != k:
-                for c in range(n):
-                    lu[g, k, c], lu[g, p, c] = lu[g, p, c], lu[g, k, c]
-            inv = 1.0 / lu[g, k, k]
-            for r in range(k + 1, n):
-                lu[g, r, k] *= inv
-                f = lu[g, r, k]
-                if f != 0.0:
-                    for c in range(k + 1, n):
-                        lu[g, r, c] -= f * lu[g, k, c]
+        _lu(lu[g], n, piv[g])
 
 
 @njit(cache=True)
-def _solve(h, b, out, gidx, gsize, lu, piv, grouped, z):
-    """``out = (I / (h gamma) - J)^-1 b``: ``h gamma b`` outside the groups."""
-    hg = h * GAMMA
+def _solve(h, gamma, b, out, gidx, gsize, lu, piv, grouped, z, jac, jace, nq, reduced):
+    """``out = (I / (h gamma) - J)^-1 b``: ``h gamma b`` outside the groups (see
+    :func:`_factor` for ``reduced``)."""
+    hg = h * gamma
     for m in range(b.shape[0]):
         if not grouped[m]:
             out[m] = hg * b[m]
+    if reduced:
+        nz = gsize[0] - nq
+        for r in range(nz):
+            s = b[nq + r]
+            for c in range(nq):
+                s += hg * jac[0, nq + r, c] * b[c]
+            z[r] = s
+        _lu_solve(lu[0], nz, piv[0], z)
+        for r in range(nz):
+            out[nq + r] = z[r]
+        for c in range(nq):
+            out[c] = hg * (b[c] + z[c])
+        # the energy integrals' rows: U_e = h gamma (b_e + J_e U) (nothing depends on them)
+        o_e = gsize[0]
+        for r in range(jace.shape[0]):
+            s = b[o_e + r]
+            for c in range(o_e):
+                s += jace[r, c] * out[c]
+            out[o_e + r] = hg * s
+        return
     for g in range(gidx.shape[0]):
         n = gsize[g]
         for r in range(n):
             z[r] = b[gidx[g, r]]
-        for k in range(n):
-            p = piv[g, k]
-            if p != k:
-                z[k], z[p] = z[p], z[k]
-        for r in range(n):
-            s = z[r]
-            for c in range(r):
-                s -= lu[g, r, c] * z[c]
-            z[r] = s
-        for r in range(n - 1, -1, -1):
-            s = z[r]
-            for c in range(r + 1, n):
-                s -= lu[g, r, c] * z[c]
-            z[r] = s / lu[g, r, r]
+        _lu_solve(lu[g], n, piv[g], z)
         for r in range(n):
             out[gidx[g, r]] = z[r]
 
@@ -207,13 +296,18 @@ def _hermite(x0, x1, f0, f1, h, th, out):
 @njit(cache=True)
 def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f, opt, theta_c,
           ag_y, ag_z, dt_rec, t_end, rtol, atol, h_max, max_events, hist_x, hist_n, hist_t, ev_t,
-          ev_kind, ev_index, acc, peak_fe, peak_fn, peak_util, peak_n, gidx, gsize, gcol, cnt):
-    """:func:`shipblock.section._kernel.run` with ROS34PW2 steps (the same arguments and
-    returns, plus the groups and ``cnt``: Jacobians, their evaluations, factorisations)."""
+          ev_kind, ev_index, acc, peak_fe, peak_fn, peak_util, peak_n, gidx, gsize, gcol, reduced,
+          hold, ta, tc, tm, te, tt, tg, gamma, expo, n_ctl, cnt):
+    """:func:`shipblock.section._kernel.run` with Rosenbrock(-W) steps (the same arguments and
+    returns, plus the groups, ``reduced`` (see :func:`_factor`), ``hold``: keep the step, and
+    so the factorisation, while the controller would enlarge it by less than that factor; the
+    method's :data:`TABLEAUS` entry; ``n_ctl``: the error is controlled on the first ``n_ctl``
+    states (``6 n_b + n_s`` as in the kernel, or all: also the energy integrals); and ``cnt``: Jacobians, their evaluations, factorisations)."""
     ns = strip_i.shape[0]
     nsp = spring_f.shape[0]
     nx = x.shape[0]
     n_err = 6 * nb + ns
+    nq = 3 * nb
     ng = 2 * nsp + ns + (nb - 1) + 4
     delta = np.zeros(nsp)
     delta_dot = np.zeros(nsp)
@@ -227,10 +321,9 @@ def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_
     k7 = np.zeros(nx)
     fst = np.zeros(nx)
     b = np.zeros(nx)
-    u1 = np.zeros(nx)
-    u2 = np.zeros(nx)
-    u3 = np.zeros(nx)
-    u4 = np.zeros(nx)
+    n_st = tm.shape[0]
+    us = np.zeros((n_st, nx))
+    ftv = np.zeros(nx)
     y = np.zeros(nx)
     x1 = np.zeros(nx)
     xe = np.zeros(nx)
@@ -243,6 +336,7 @@ def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_
     n_g, gmax = gidx.shape
     jac = np.zeros((n_g, gmax, gmax))
     lu = np.zeros((n_g, gmax, gmax))
+    jace = np.zeros((nx - n_err, n_err))
     piv = np.zeros((n_g, gmax), np.int64)
     z = np.zeros(gmax)
     grouped = np.zeros(nx, np.bool_)
@@ -292,51 +386,69 @@ def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_
             stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
                       ag_z, dt_rec, sums, f0)
             cnt[1] += _jacobian(t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs,
-                                opt, ag_y, ag_z, dt_rec, sums, gidx, gsize, gcol, jac, y, fp)
+                                opt, ag_y, ag_z, dt_rec, sums, gidx, gsize, gcol, jac, jace, y,
+                                fp)
             cnt[0] += 1
             stale = False
             h_lu = -1.0
         if h != h_lu:
-            _factor(h, jac, gsize, lu, piv)
+            _factor(h, gamma, jac, gsize, lu, piv, nq, reduced)
             cnt[2] += 1
             h_lu = h
-        # the four stages
-        _solve(h, k1, u1, gidx, gsize, lu, piv, grouped, z)
-        for m in range(nx):
-            y[m] = x[m] + A21 * u1[m]
-        stage_rhs(t + T2 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
-                  ag_z, dt_rec, sums, fst)
-        for m in range(nx):
-            b[m] = fst[m] + C21 / h * u1[m]
-        _solve(h, b, u2, gidx, gsize, lu, piv, grouped, z)
-        for m in range(nx):
-            y[m] = x[m] + A31 * u1[m] + A32 * u2[m]
-        stage_rhs(t + T3 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
-                  ag_z, dt_rec, sums, fst)
-        for m in range(nx):
-            b[m] = fst[m] + (C31 * u1[m] + C32 * u2[m]) / h
-        _solve(h, b, u3, gidx, gsize, lu, piv, grouped, z)
-        for m in range(nx):
-            y[m] = x[m] + A41 * u1[m] + A42 * u2[m] + A43 * u3[m]
-        stage_rhs(t + T4 * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
-                  ag_z, dt_rec, sums, fst)
-        for m in range(nx):
-            b[m] = fst[m] + (C41 * u1[m] + C42 * u2[m] + C43 * u3[m]) / h
-        _solve(h, b, u4, gidx, gsize, lu, piv, grouped, z)
+        # f's time derivative (the ground motion's slope over this sample interval)
+        ks = int(math.floor(t / dt_rec + 1e-9))
+        say, saz = 0.0, 0.0
+        if ks + 1 < ag_y.shape[0]:
+            say = (ag_y[ks + 1] - ag_y[ks]) / dt_rec
+            saz = (ag_z[ks + 1] - ag_z[ks]) / dt_rec
+        wdot = 0.0
+        for bo in range(nb):
+            ftv[nq + 3 * bo] = -say
+            ftv[nq + 3 * bo + 1] = -saz
+            wdot -= mass[bo] * (say * x[nq + 3 * bo] + saz * x[nq + 3 * bo + 1])
+        ftv[6 * nb + ns] = wdot
+        # the stages
+        for i in range(n_st):
+            if i == 0:
+                for m in range(nx):
+                    b[m] = k1[m]
+            else:
+                for m in range(nx):
+                    sy = x[m]
+                    sb = 0.0
+                    for j in range(i):
+                        sy += ta[i, j] * us[j, m]
+                        sb += tc[i, j] * us[j, m]
+                    y[m] = sy
+                    b[m] = sb / h
+                stage_rhs(t + tt[i] * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs,
+                          opt, ag_y, ag_z, dt_rec, sums, fst)
+                for m in range(nx):
+                    b[m] += fst[m]
+            if tg[i] != 0.0:
+                for m in range(nx):
+                    b[m] += tg[i] * h * ftv[m]
+            _solve(h, gamma, b, us[i], gidx, gsize, lu, piv, grouped, z, jac, jace, nq,
+                   reduced)
         err = 0.0
         for m in range(nx):
-            x1[m] = x[m] + M1 * u1[m] + M2 * u2[m] + M3 * u3[m] + M4 * u4[m]
-        for m in range(n_err):
-            e = E1 * u1[m] + E2 * u2[m] + E3 * u3[m] + E4 * u4[m]
+            sy = x[m]
+            for i in range(n_st):
+                sy += tm[i] * us[i, m]
+            x1[m] = sy
+        for m in range(n_ctl):
+            e = 0.0
+            for i in range(n_st):
+                e += te[i] * us[i, m]
             sc = atol + rtol * max(abs(x[m]), abs(x1[m]))
             err += (e / sc) ** 2
-        err = math.sqrt(err / n_err)
+        err = math.sqrt(err / n_ctl)
         if not (err <= 1.0):
             n_rej += 1
             if err != err:
                 h *= 0.1
             else:
-                h *= max(0.1, 0.9 * err ** (-1.0 / 3.0))
+                h *= max(0.1, 0.9 * err ** -expo)
             continue
         n_acc += 1
         rhs(t + h, x1, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt,
@@ -435,7 +547,8 @@ def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_
             event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
                          delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
             stale = True
-        h = h * min(5.0, max(0.2, 0.9 * max(err, 1e-10) ** (-1.0 / 3.0)))
+        h_new = h * min(5.0, max(0.2, 0.9 * max(err, 1e-10) ** -expo))
+        h = h_lu if (not stale and h_lu <= h_new <= hold * h_lu) else h_new
     for i in range(nsp):
         if reg[i] == K.R_FREE and dc0[i] > dp[i]:
             rem = cap_surface(spring_f[i, K.PF_K], spring_f[i, K.PF_C], dp[i], dc0[i], tc0[i],
@@ -446,11 +559,17 @@ def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_
     return t, n_ev, failure, n_hist, n_acc, n_rej
 
 
-def simulate_w(section, ah, av, dt, rtol, atol, kind="lines"):
+def simulate_w(section, ah, av, dt, rtol, atol, kind="full", hold=1.0, method="ROS34PW2",
+               energy_error=False):
     """One run of :func:`run_w` from the static state, as
     :func:`shipblock.section.simulate.simulate_section` makes it (the same energy balance and
-    summary); returns ``(SectionResult, counts)`` with the Jacobians, their evaluations and the
-    factorisations."""
+    summary); ``kind`` names the Jacobian's groups (:func:`jacobian_groups`; ``"full"`` is
+    solved through its Schur complement, :func:`_factor`), ``hold`` see :func:`run_w`,
+    ``method`` a :data:`TABLEAUS` key, ``energy_error``: the energy integrals' error controlled
+    too. Returns
+    ``(SectionResult, counts)`` with the Jacobians, their evaluations and the factorisations."""
+    if section.roll_held:
+        raise ValueError("the prototype takes q' = v for every position: no held roll")
     asm = assemble(section, DEFAULT_SEPARATION_HEIGHT)
     init = static_state(asm)
     nb, ns = asm.n_bodies, asm.n_strips
@@ -470,7 +589,8 @@ def simulate_w(section, ah, av, dt, rtol, atol, kind="lines"):
         x, reg, dp, dc0, tc0, fs, nb, asm.mass, asm.inertia, asm.strip_f, asm.strip_i,
         asm.spring_f, asm.opt, asm.theta_c, ah, av, dt, (n - 1) * dt, rtol, atol, dt, 10**6,
         hist_x, hist_n, hist_t, ev_t, ev_kind, ev_index, acc, peak_fe, peak_fn, peak_util, peak_n,
-        gidx, gsize, gcol, cnt)
+        gidx, gsize, gcol, kind == "full", hold, *TABLEAUS[method],
+        x.size if energy_error else 6 * nb + ns, cnt)
     e1 = energy_terms(asm, x, reg, dp, dc0, tc0, fs, t)
     o = 6 * nb + ns
     w_ground, w_wind, d_damp, d_fric = x[o:o + 4]
@@ -513,12 +633,92 @@ def _cpu(fn, repeats):
     return best, out
 
 
-def main(kinds=("lines",), tolerances=((1e-4, 1e-7), (1e-5, 1e-8), (1e-6, 1e-9)), repeats=3):
+#: the prototype's variants in the table: (label, Jacobian groups, method)
+VARIANTS = (("ROS34PW2 [lines]", "lines", "ROS34PW2"), ("ROS34PW2 [full]", "full", "ROS34PW2"),
+            ("ROS34PW3 [full]", "full", "ROS34PW3"), ("RODAS4 [full, at events]", "full", "RODAS4"))
+
+
+@njit(cache=True)
+def _repeat(part, n, t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, dc0,
+            tc0, fs, opt, theta_c, ag_y, ag_z, dt_rec, sums, gidx, gsize, gcol, jac, jace, lu,
+            piv, grouped, z, out, xp, gv):
+    """Call one piece of a step ``n`` times (for :func:`part_costs`)."""
+    nsp = spring_f.shape[0]
+    delta, delta_dot, vt = np.zeros(nsp), np.zeros(nsp), np.zeros(ns)
+    pos, fe, fn = np.zeros((nsp, 2)), np.zeros(nsp), np.zeros(nsp)
+    normal, tang = np.zeros(ns), np.zeros(ns)
+    for _ in range(n):
+        if part == 0:
+            stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y, ag_z,
+                      dt_rec, sums, out)
+        elif part == 1:
+            rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y,
+                ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, out)
+        elif part == 2:
+            event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
+                         delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, gv)
+        elif part == 3:
+            _factor(1e-3, GAMMA_PW2, jac, gsize, lu, piv, 3 * nb, True)
+        elif part == 4:
+            _solve(1e-3, GAMMA_PW2, f0, out, gidx, gsize, lu, piv, grouped, z, jac, jace, 3 * nb,
+                   True)
+        else:
+            _jacobian(t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
+                      ag_z, dt_rec, sums, gidx, gsize, gcol, jac, jace, xp, out)
+
+
+GAMMA_PW2 = TABLEAUS["ROS34PW2"][6]
+
+
+def part_costs(n=20000):
+    """CPU microseconds per call of the pieces of a step at the benchmark's static state (the
+    full Jacobian's Schur complement for the factorisation and the solve)."""
+    dock = navy_dock()
+    h, v, dt = record()
+    asm = assemble(dock, DEFAULT_SEPARATION_HEIGHT)
+    init = static_state(asm)
+    nb, ns = asm.n_bodies, asm.n_strips
+    nsp = asm.spring_f.shape[0]
+    x, reg, fs = init.x.copy(), init.regime.copy(), init.friction.copy()
+    dp, dc0, tc0 = np.zeros(nsp), np.zeros(nsp), np.zeros(nsp)
+    sums = np.zeros((ns, N_RS))
+    regime_sums(asm.strip_i, asm.spring_f, reg, dp, sums)
+    gidx, gsize, gcol = jacobian_groups(asm, "full")
+    nm = int(gsize[0])
+    jac, jace = np.zeros((1, nm, nm)), np.zeros((x.size - nm, nm))
+    lu, piv = np.zeros((1, nm, nm)), np.zeros((1, nm), np.int64)
+    grouped = np.zeros(x.size, np.bool_)
+    grouped[:nm] = True
+    f0, out, xp = np.zeros(x.size), np.zeros(x.size), np.zeros(x.size)
+    gv = np.zeros(2 * nsp + ns + nb - 1 + 4)
+    args = (0.1, x, f0, nb, ns, asm.mass, asm.inertia, asm.strip_f, asm.strip_i, asm.spring_f,
+            reg, dp, dc0, tc0, fs, asm.opt, asm.theta_c, h, v, dt, sums, gidx, gsize, gcol, jac,
+            jace, lu, piv, grouped, np.zeros(nm), out, xp, gv)
+    stage_rhs(0.1, x, nb, ns, asm.mass, asm.inertia, asm.strip_f, asm.strip_i, asm.spring_f, fs,
+              asm.opt, h, v, dt, sums, f0)
+    names = ("stage_rhs", "rhs", "event_values", "factorisation (18 x 18 Schur complement)",
+             "solve (Schur complement)", "Jacobian (30 differences)")
+    out_us = {}
+    for part, name in enumerate(names):
+        _repeat(part, 10, *args)  # compile / warm
+        m = n // 30 if part == 5 else n
+        best = BIG
+        for _ in range(3):
+            c0 = time.process_time()
+            _repeat(part, m, *args)
+            best = min(best, time.process_time() - c0)
+        out_us[name] = 1e6 * best / m
+    return out_us
+
+
+def main(variants=VARIANTS, tolerances=((1e-4, 1e-7), (1e-5, 1e-8), (1e-6, 1e-9)), repeats=3):
+    """Print the table (markdown) and the cost of the pieces of a step."""
+    print("CPU us per call:", {k: round(v, 3) for k, v in part_costs().items()}, flush=True)
     dock = navy_dock()
     h, v, dt = record()
     simulate_section(dock, h[:400], v[:400], dt)  # compile
-    for kind in kinds:
-        simulate_w(dock, h[:400], v[:400], dt, 1e-6, 1e-9, kind)
+    for _, kind, method in variants:
+        simulate_w(dock, h[:400], v[:400], dt, 1e-6, 1e-9, kind, method=method)
     ref = simulate_section(dock, h, v, dt, rtol=1e-10, atol=1e-13)
     print("reference (DOPRI5, rtol 1e-10, atol 1e-13):", ref.stats,
           {k: ref.summary[k] for k in KEYS}, f"energy {ref.energy['residual']:.1e}")
@@ -527,10 +727,11 @@ def main(kinds=("lines",), tolerances=((1e-4, 1e-7), (1e-5, 1e-8), (1e-6, 1e-9))
           "| peak sway | peak roll |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for rtol, atol in tolerances:
-        rows = [("DOPRI5", lambda: (simulate_section(dock, h, v, dt, rtol=rtol, atol=atol), None))]
-        for kind in kinds:
-            rows.append((f"ROS34PW2 [{kind}]",
-                         lambda kind=kind: simulate_w(dock, h, v, dt, rtol, atol, kind)))
+        rows = [("DOPRI5 (kernel)",
+                 lambda: (simulate_section(dock, h, v, dt, rtol=rtol, atol=atol), None))]
+        for label, kind, method in variants:
+            rows.append((label, lambda kind=kind, method=method: simulate_w(
+                dock, h, v, dt, rtol, atol, kind, method=method)))
         for name, fn in rows:
             cpu, (res, cnt) = _cpu(fn, repeats)
             e = errors(res, ref)
@@ -545,4 +746,4 @@ def main(kinds=("lines",), tolerances=((1e-4, 1e-7), (1e-5, 1e-8), (1e-6, 1e-9))
 
 
 if __name__ == "__main__":
-    main(kinds=tuple(sys.argv[1:]) or ("lines",))
+    main()
