@@ -1,20 +1,25 @@
-"""Prototype (not the solver): a Rosenbrock-W method for the dock-section model, measured
-against the Dormand-Prince kernel (issue 29's speed part).
+"""Prototype (not the solver): linearly implicit (Rosenbrock and Rosenbrock-W) steps for the
+dock-section model, with a Jacobian computed only at events, measured against the
+Dormand-Prince kernel (issue 29's speed part). Findings: ``docs/theory/section_wmethod_notes.md``.
 
-ROS34PW2 (Rang and Angermann 2005: 4 stages, order 3 with an embedded order 2, L-stable,
-stiffly accurate, and a *W-method*: it keeps its order with any matrix ``J`` in
-``W = I - h gamma J``). Written in the transformed variables of Hairer and Wanner (1996,
-IV.7, eq. 7.25), which need no product with ``J``:
+Methods (:data:`TABLEAUS`): ROS34PW2 (Rang and Angermann 2005: 4 stages, order 3 with an
+embedded order 2, L-stable, stiffly accurate, and a *W-method*: it keeps its order with any
+matrix ``J`` in ``W = I - h gamma J``); ROS34PW3 (same paper: order 4 with the exact Jacobian, 3
+as a W-method, A-stable); RODAS4 (Hairer and Wanner 1996: order 4 with the exact Jacobian, not a
+W-method, for comparison with the RODAS4 prototype of ``docs/theory/section.md`` that made a new
+Jacobian at every step). All in the transformed variables of Hairer and Wanner (1996, IV.7,
+eq. 7.25), which need no product with ``J``:
 
 .. math::
 
-    \\Big(\\frac{I}{h\\gamma} - J\\Big) U_i = f\\Big(t + \\alpha_i h,\\; x_0 + \\sum_{j<i}
-    a_{ij} U_j\\Big) + \\sum_{j<i} \\frac{c_{ij}}{h} U_j, \\qquad
-    x_1 = x_0 + \\sum_i m_i U_i,
+    \Big(\frac{I}{h\gamma} - J\Big) U_i = f\Big(t + \alpha_i h,\; x_0 + \sum_{j<i}
+    a_{ij} U_j\Big) + \sum_{j<i} \frac{c_{ij}}{h} U_j + \gamma_i h f_t, \qquad
+    x_1 = x_0 + \sum_i m_i U_i,
 
-with ``(a_ij) = alpha Gamma^-1``, ``(c_ij) = diag(1/gamma) - Gamma^-1``, ``m = b Gamma^-1``. The
-time derivative of ``f`` (the ground motion, linear between samples) is left out of the matrix,
-which a W-method allows.
+with ``(a_ij) = alpha Gamma^-1``, ``(c_ij) = diag(1/gamma) - Gamma^-1``, ``m = b Gamma^-1``,
+``gamma_i`` the sums of ``Gamma``'s rows and ``f_t`` the time derivative of the rates (the
+ground motion's slope over the sample interval). Checked on a small nonlinear problem: global
+orders 3.0 (ROS34PW2, also with a wrong ``J``), 3.6-3.8 (ROS34PW3) and 4.0 (RODAS4).
 
 ``J`` is a finite-difference Jacobian computed only at the start and after every event (with
 the regime sums of :func:`shipblock.section._forces.stage_rhs`) and reused between events. It
@@ -22,19 +27,19 @@ is kept to *groups* of states: ``"lines"`` - one group per moving block line (it
 and velocities and the stick-spring extensions of its strips), the ship treated explicitly
 (``W = I`` there) and the coupling between the ship and the lines left out; ``"lines+ship"`` -
 also the ship's 6 states (and the stick springs of strips on fixed lines) as a group;
-``"full"`` - one group of all 6 n_b + n_s mechanical states. Groups of one colour (the lines:
-no line's rate depends on another line's state) are differenced together, so ``"lines"`` costs
-8 evaluations per event, ``"full"`` 30. The matrix ``I/(h gamma) - J`` is factorised per group
-(LU with partial pivoting) whenever ``h`` changes.
+``"full"`` - all 6 n_b + n_s mechanical states, plus the energy integrals' rows. Groups of one
+colour (the lines: no line's rate depends on another line's state) are differenced together,
+so ``"lines"`` costs 8 evaluations per event, ``"full"`` 30. ``I/(h gamma) - J`` is factorised
+per group (LU with partial pivoting) whenever ``h`` changes; the full one through its Schur
+complement on the velocities and stick springs (18 x 18 for the benchmark, :func:`_factor`).
 
 Dense output for the event location: the cubic Hermite interpolant of ``x_0, x_1`` and the
 rates there (both evaluated anyway: ``f(x_0)`` is the first stage, ``f(x_1)`` the event
-functions' forces), order 3 like the method. The events, their transitions and the settling
-after them are the kernel's (:func:`shipblock.section._kernel._event_values_of`,
-``_transition``, ``_settle``), unchanged.
+functions' forces), order 3. The events, their transitions and the settling after them are
+the kernel's (:func:`shipblock.section._kernel._event_values_of`, ``_transition``,
+``_settle``), unchanged.
 
-Run: ``python tests/tools/section_wmethod.py`` (prints the table of
-``docs/theory/section_wmethod_notes.md``; a few minutes).
+Run: ``python tests/tools/section_wmethod.py`` (prints the table of the notes; ~1.5 min).
 """
 
 from __future__ import annotations
@@ -302,7 +307,8 @@ def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_
     returns, plus the groups, ``reduced`` (see :func:`_factor`), ``hold``: keep the step, and
     so the factorisation, while the controller would enlarge it by less than that factor; the
     method's :data:`TABLEAUS` entry; ``n_ctl``: the error is controlled on the first ``n_ctl``
-    states (``6 n_b + n_s`` as in the kernel, or all: also the energy integrals); and ``cnt``: Jacobians, their evaluations, factorisations)."""
+    states (``6 n_b + n_s`` as in the kernel, or all: also the energy integrals); and ``cnt``:
+    Jacobians, their evaluations, factorisations)."""
     ns = strip_i.shape[0]
     nsp = spring_f.shape[0]
     nx = x.shape[0]
