@@ -57,9 +57,10 @@ COMPARE_RTOL, COMPARE_ATOL = 1e-9, 1e-12
 FAILURE_TIME_TOL = 1e-3
 #: Largest relative difference of a demand parameter from the tight run's.
 SUMMARY_TOL = 1e-2
-#: Summary values of the *total* cap force (the dashpot's included), whose peaks the kernel takes
-#: at step ends and events only: a short dashpot spike inside a step is missed, so these are
-#: compared apart (``peak_total_load_diff``) and not held to ``SUMMARY_TOL``.
+#: Summary values of the *total* cap force (the dashpot's included), whose peak is often a short
+#: dashpot spike inside a step: held to ``SUMMARY_TOL`` with the others, and also reported apart
+#: (``peak_total_load_diff``; taken at step ends and events only they were up to 16 % off, now
+#: the kernel looks inside the steps).
 PEAK_TOTAL_KEYS = ("peak_load_per_block", "capacity_ratio")
 #: Floor of each kind of summary value below which differences are not relative (its unit).
 _FLOORS = (("load_per_block", 1e2), ("pressure_ratio", 1e-5), ("pressure", 1e3),
@@ -194,7 +195,7 @@ def _compare(res, tight) -> dict:
             d = abs(w - v) / max(abs(v), abs(w), _floor(k))
             if k.endswith(PEAK_TOTAL_KEYS):
                 worst_peak = max(worst_peak, d)
-            elif d > worst:
+            if d > worst:
                 worst, key = d, k
     ok = (same_failure and (dt_fail is None or dt_fail <= FAILURE_TIME_TOL) and not missed
           and not extra and worst <= SUMMARY_TOL)

@@ -401,7 +401,7 @@ def regime_sums(strip_i, spring_f, reg, dp, sums):
 
 @njit(cache=True)
 def stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y, ag_z, dt_rec,
-              sums, xdot):
+              sums, xdot, stage_n):
     """:func:`rhs` from the regime sums (:func:`regime_sums`): a strip costs the same whatever
     its number of springs, and no spring's force is kept (the integrator's inner stages).
 
@@ -411,7 +411,8 @@ def stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, 
     coefficients; the damping loss rate ``sum c_i (E0 + w m_i)^2`` likewise, and the
     centre of pressure where the friction acts (``sum f_i (r_i . a) / sum f_i``,
     :func:`friction_offset`) from one more quadratic form. Equal to :func:`rhs` but for
-    rounding.
+    rounding. ``stage_n[j]`` is raised to strip j's normal force if that is larger (the
+    integrator looks inside a step for a peak of the force when a stage's exceeds the ends').
     """
     ay, az = _start_rates(t, x, nb, mass, opt, ag_y, ag_z, dt_rec, xdot)
     d_damp = 0.0
@@ -428,6 +429,8 @@ def stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, 
         c_mm = a2 * a2 * sm[RS_CYY] - 2.0 * a1 * a2 * sm[RS_CYZ] + a1 * a1 * sm[RS_CZZ]
         # normal force (elastic, crushing, dashpot) and its moment about c
         total = sm[RS_K] * d0 - sm[RS_KD] - k_ra + sm[RS_F] + sm[RS_C] * e0 + w * c_m
+        if total > stage_n[j]:
+            stage_n[j] = total
         moment = (d0 * k_m - (sm[RS_KDY] * a2 - sm[RS_KDZ] * a1) - k_ra_m
                   + sm[RS_FY] * a2 - sm[RS_FZ] * a1 + e0 * c_m + w * c_mm)
         d_damp += e0 * e0 * sm[RS_C] + 2.0 * e0 * w * c_m + w * w * c_mm

@@ -168,7 +168,7 @@ def _jacobian(t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, o
                     m = gidx[g, p]
                     xp[m] = x[m] + 1e-8 * max(abs(x[m]), 1e-3)
             stage_rhs(t, xp, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
-                      ag_z, dt_rec, sums, fp)
+                      ag_z, dt_rec, sums, fp, np.zeros(ns))
             n_eval += 1
             for g in range(gidx.shape[0]):
                 if gcol[g] == colour and p < gsize[g]:
@@ -390,7 +390,7 @@ def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_
             break
         if stale:
             stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
-                      ag_z, dt_rec, sums, f0)
+                      ag_z, dt_rec, sums, f0, np.zeros(ns))
             cnt[1] += _jacobian(t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs,
                                 opt, ag_y, ag_z, dt_rec, sums, gidx, gsize, gcol, jac, jace, y,
                                 fp)
@@ -428,7 +428,7 @@ def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_
                     y[m] = sy
                     b[m] = sb / h
                 stage_rhs(t + tt[i] * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs,
-                          opt, ag_y, ag_z, dt_rec, sums, fst)
+                          opt, ag_y, ag_z, dt_rec, sums, fst, np.zeros(ns))
                 for m in range(nx):
                     b[m] += fst[m]
             if tg[i] != 0.0:
@@ -656,7 +656,7 @@ def _repeat(part, n, t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f
     for _ in range(n):
         if part == 0:
             stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y, ag_z,
-                      dt_rec, sums, out)
+                      dt_rec, sums, out, np.zeros(ns))
         elif part == 1:
             rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y,
                 ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, out)
@@ -701,7 +701,7 @@ def part_costs(n=20000):
             reg, dp, dc0, tc0, fs, asm.opt, asm.theta_c, h, v, dt, sums, gidx, gsize, gcol, jac,
             jace, lu, piv, grouped, np.zeros(nm), out, xp, gv)
     stage_rhs(0.1, x, nb, ns, asm.mass, asm.inertia, asm.strip_f, asm.strip_i, asm.spring_f, fs,
-              asm.opt, h, v, dt, sums, f0)
+              asm.opt, h, v, dt, sums, f0, np.zeros(ns))
     names = ("stage_rhs", "rhs", "event_values", "factorisation (18 x 18 Schur complement)",
              "solve (Schur complement)", "Jacobian (30 differences)")
     out_us = {}
