@@ -312,3 +312,45 @@ def test_processing_chain_file_is_read_through_the_checked_toml_reader(tmp_path,
                     encoding="utf-8")
     code, _, err = run(capsys, "info", "--record", "NP.1759", "--processing", str(deep))
     assert code != 0 and str(deep) in err and "nested deeper" in err
+
+
+def test_vertical_scale_with_no_vertical_is_a_usage_error_naming_both(capsys):
+    """--vertical-scale with --no-vertical used to run with the scale ignored: now argparse
+    refuses the pair (exit status 2) naming both flags, before any record is read."""
+    with pytest.raises(SystemExit) as exc:
+        main(["-q", "simulate", "--record", "NP.1765", "--vertical-scale", "2", "--no-vertical"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "--vertical-scale" in err and "--no-vertical" in err and "not allowed" in err
+
+
+def test_vertical_scale_of_a_record_without_vertical_is_refused(capsys):
+    from pathlib import Path
+
+    at2 = Path(__file__).parent / "data" / "helena_synthetic_180.AT2"  # one horizontal only
+    code, _, err = run(capsys, "simulate", str(at2), "--processing", "none",
+                       "--vertical-scale", "2")
+    assert code == 2
+    assert err.startswith("shipblock: error: --vertical-scale 2:") and "no vertical" in err
+
+
+@pytest.mark.parametrize("flag,value", [("--atol", "5"), ("--atol", "0"), ("--rtol", "5")])
+def test_tolerance_outside_the_solvers_range_names_the_flag(flag, value, capsys):
+    code, _, err = run(capsys, "simulate", "--record", "NP.1765", flag, value)
+    assert code == 2
+    assert err.startswith(f"shipblock: error: {flag} must be") and "rigid model" in err
+
+
+def test_atol_reaches_the_rigid_solver_and_is_stored(tmp_path, capsys):
+    """--atol is the rigid solver's absolute tolerance: the value used is the one stored with
+    the response (solver_atol), beside the default --rtol; the default run stores 1e-10."""
+    from shipblock.solver import DEFAULT_ATOL
+
+    given, default = tmp_path / "given.nc", tmp_path / "default.nc"
+    common = ["simulate", "--record", "NP.1765", "--scale", "2.6", "--figure",
+              str(tmp_path / "f.png")]
+    assert run(capsys, *common, "--atol", "1e-7", "-o", str(given))[0] == 0
+    assert run(capsys, *common, "-o", str(default))[0] == 0
+    with xr.open_dataset(given) as a, xr.open_dataset(default) as b:
+        assert a.attrs["solver_atol"] == 1e-7 and b.attrs["solver_atol"] == DEFAULT_ATOL
+        assert a.attrs["solver_rtol"] == b.attrs["solver_rtol"] == 1e-8

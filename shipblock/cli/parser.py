@@ -65,11 +65,20 @@ def build_parser():
     g.add_argument("--target-pga", metavar="PGA",
                    help="scale to this PGA of the horizontal, with its unit: 0.4g, 3.9m/s^2, "
                         "392gal (the vertical by the same factor unless --vertical-scale)")
-    g.add_argument("--vertical-scale", type=float, help="independent factor on the vertical")
-    g.add_argument("--no-vertical", action="store_true", help="ignore the vertical component")
+    # one or the other: a factor on a vertical that is dropped would be ignored without a word
+    vertical = g.add_mutually_exclusive_group()
+    vertical.add_argument("--vertical-scale", type=float,
+                          help="independent factor on the vertical (not with --no-vertical)")
+    vertical.add_argument("--no-vertical", action="store_true",
+                          help="ignore the vertical component (not with --vertical-scale)")
     g.add_argument("--rtol", type=float,
                    help="relative tolerance of the integration (default: 1e-8 for the rigid "
                         "model's rocking phases, the section model's own otherwise)")
+    g.add_argument("--atol", type=float,
+                   help="absolute tolerance of the integration, in the unit of each state: m "
+                        "and m/s for displacements and velocities, rad and rad/s for rotations "
+                        "(default: 1e-10 for the rigid model's rocking phases, the section "
+                        "model's own, 1e-9, otherwise); checked against the model's range")
     g.add_argument("--output", "-o", help="NetCDF file for the response")
     g.add_argument("--figure", help="PNG for the response figure (default: next to --output)")
     g.add_argument("--events", type=int, default=20, help="list at most this many events")
