@@ -265,8 +265,9 @@ def build_parser():
     s.add_argument("--format", choices=["html", "pdf"],
                    help="html (one self-contained file) or pdf (A4 pages, the same content); "
                         "default: from the suffix of --output, else html")
-    s.add_argument("--output", "-o", help="file to write (default report.html, or report.pdf "
-                                          "with --format pdf)")
+    s.add_argument("--output", "-o",
+                   help="file to write (default: <results stem>_report.html beside the results, "
+                        "or _report.pdf with --format pdf)")
     s.set_defaults(func=cmd_report)
 
     s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "
