@@ -213,8 +213,15 @@ def build_parser():
     s.add_argument("--no-scale", action="store_true", help="compare the records unscaled")
     s.add_argument("--min-scale-factor", type=float, default=0.25, help="default 0.25")
     s.add_argument("--max-scale-factor", type=float, default=4.0, help="default 4")
-    s.add_argument("--no-processing", action="store_true",
-                   help="spectra of the records as read (default: the default processing chain)")
+    chain = s.add_mutually_exclusive_group()
+    chain.add_argument("--no-processing", action="store_true",
+                       help="spectra of the records as read (default: the default processing "
+                            "chain; not with --processing)")
+    chain.add_argument("--processing", metavar="FILE",
+                       help="processing chain before the spectra: a TOML file with "
+                            "[[processing]] steps, as a pipeline's (checked before any record "
+                            "is read), or 'default', 'demean', 'none' as for simulate (not "
+                            "with --no-processing)")
     s.add_argument("--ids", nargs="+", action="extend", metavar="ID",
                    help="only these catalogue records (default: all), e.g. --ids NP.1765 "
                         "NP.1764")
