@@ -111,6 +111,22 @@ def test_run_demo_pipeline_prints_fits_and_draws(tmp_path, capsys):
     med = float(ds["median"].sel(limit_state="ship_slip")) / STANDARD_GRAVITY
     printed = [line for line in out.splitlines() if line.strip().startswith("ship_slip ")][0]
     assert f"{med:.3g}" in printed
+    # resamples of the bootstrap that could not be fitted are said, with the count stored and
+    # the most frequent reason (they used to be dropped from the band without a word)
+    lines = out.splitlines()
+    for ls in ds["limit_state"].values:
+        n_failed = int(ds["bootstrap_failed"].sel(limit_state=ls))
+        row = next(i for i, line in enumerate(lines) if line.strip().startswith(f"{ls} "))
+        note = lines[row + 1].strip()
+        if n_failed:
+            n_boot = ds["median_lower"].attrs["n_bootstrap"]
+            why = str(ds["bootstrap_failure"].sel(limit_state=ls).values)
+            assert note == (f"({n_failed} of {n_boot} bootstrap resamples could not be fitted, "
+                            f"left out of the band; {why})")
+            assert why.startswith("the most frequent reason (") and why.endswith("[IM in g]")
+        else:
+            assert "bootstrap" not in note
+    assert int(ds["bootstrap_failed"].sel(limit_state="ship_slip")) > 0  # the demo's 66 of 200
     code, _, _ = run(capsys, "plot", str(nc), "--kind", "ida", "--figure", str(tmp_path / "i.png"))
     assert code == 0 and (tmp_path / "i.png").exists()
     # the study says what it used, in the pipeline's units (levels_g: g, no m/s^2 anywhere)
