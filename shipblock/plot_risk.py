@@ -128,7 +128,7 @@ def plot_hazard_and_fragility(ds, limit_state=None, ax=None, sweep=None):
     x = ds["hazard_im"].values / factor
     rate = ds["hazard_rate"].values
     positive = rate > 0
-    ax.loglog(x[positive], rate[positive], "k.-", label="site hazard")
+    ax.loglog(x[positive], rate[positive], "k.-", label="site hazard (left axis)")
     ax.set_xlabel(f"{ds.attrs.get('hazard_measure', 'IM')} [{unit}]")
     ax.set_ylabel("annual rate of exceedance [1/yr]")
     ax.grid(True, which="both", alpha=0.3)
@@ -141,8 +141,13 @@ def plot_hazard_and_fragility(ds, limit_state=None, ax=None, sweep=None):
             twin.plot(grid, ndtr(np.log(grid / median) / beta), label=name)
     twin.set_ylim(0.0, 1.0)
     twin.set_ylabel("P(limit state | IM)")
-    if twin.get_legend_handles_labels()[0]:
-        twin.legend(fontsize="small", loc="center right")
+    # one legend for both axes, on the twin (drawn above the hazard's axes): the hazard curve
+    # first, then each limit state's fragility; centre left, where a hazard curve falling
+    # from the top left and fragilities rising at the right leave the axes empty (lower left
+    # covered the fragilities' zero line)
+    hazard, fragilities = ax.get_legend_handles_labels(), twin.get_legend_handles_labels()
+    twin.legend(hazard[0] + fragilities[0], hazard[1] + fragilities[1], fontsize="small",
+                loc="center left")
     site = ds.attrs.get("hazard_site", "")
     ax.set_title(f"hazard at {site}" if site else "site hazard", fontsize="medium")
     return ax, twin

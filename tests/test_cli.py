@@ -111,6 +111,22 @@ def test_run_demo_pipeline_prints_fits_and_draws(tmp_path, capsys):
     med = float(ds["median"].sel(limit_state="ship_slip")) / STANDARD_GRAVITY
     printed = [line for line in out.splitlines() if line.strip().startswith("ship_slip ")][0]
     assert f"{med:.3g}" in printed
+    # resamples of the bootstrap that could not be fitted are said, with the count stored and
+    # the most frequent reason (they used to be dropped from the band without a word)
+    lines = out.splitlines()
+    for ls in ds["limit_state"].values:
+        n_failed = int(ds["bootstrap_failed"].sel(limit_state=ls))
+        row = next(i for i, line in enumerate(lines) if line.strip().startswith(f"{ls} "))
+        note = lines[row + 1].strip()
+        if n_failed:
+            n_boot = ds["median_lower"].attrs["n_bootstrap"]
+            why = str(ds["bootstrap_failure"].sel(limit_state=ls).values)
+            assert note == (f"({n_failed} of {n_boot} bootstrap resamples could not be fitted, "
+                            f"left out of the band; {why})")
+            assert why.startswith("the most frequent reason (") and why.endswith("[IM in g]")
+        else:
+            assert "bootstrap" not in note
+    assert int(ds["bootstrap_failed"].sel(limit_state="ship_slip")) > 0  # the demo's 66 of 200
     code, _, _ = run(capsys, "plot", str(nc), "--kind", "ida", "--figure", str(tmp_path / "i.png"))
     assert code == 0 and (tmp_path / "i.png").exists()
     # the study says what it used, in the pipeline's units (levels_g: g, no m/s^2 anywhere)
@@ -312,3 +328,45 @@ def test_processing_chain_file_is_read_through_the_checked_toml_reader(tmp_path,
                     encoding="utf-8")
     code, _, err = run(capsys, "info", "--record", "NP.1759", "--processing", str(deep))
     assert code != 0 and str(deep) in err and "nested deeper" in err
+
+
+def test_vertical_scale_with_no_vertical_is_a_usage_error_naming_both(capsys):
+    """--vertical-scale with --no-vertical used to run with the scale ignored: now argparse
+    refuses the pair (exit status 2) naming both flags, before any record is read."""
+    with pytest.raises(SystemExit) as exc:
+        main(["-q", "simulate", "--record", "NP.1765", "--vertical-scale", "2", "--no-vertical"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "--vertical-scale" in err and "--no-vertical" in err and "not allowed" in err
+
+
+def test_vertical_scale_of_a_record_without_vertical_is_refused(capsys):
+    from pathlib import Path
+
+    at2 = Path(__file__).parent / "data" / "helena_synthetic_180.AT2"  # one horizontal only
+    code, _, err = run(capsys, "simulate", str(at2), "--processing", "none",
+                       "--vertical-scale", "2")
+    assert code == 2
+    assert err.startswith("shipblock: error: --vertical-scale 2:") and "no vertical" in err
+
+
+@pytest.mark.parametrize("flag,value", [("--atol", "5"), ("--atol", "0"), ("--rtol", "5")])
+def test_tolerance_outside_the_solvers_range_names_the_flag(flag, value, capsys):
+    code, _, err = run(capsys, "simulate", "--record", "NP.1765", flag, value)
+    assert code == 2
+    assert err.startswith(f"shipblock: error: {flag} must be") and "rigid model" in err
+
+
+def test_atol_reaches_the_rigid_solver_and_is_stored(tmp_path, capsys):
+    """--atol is the rigid solver's absolute tolerance: the value used is the one stored with
+    the response (solver_atol), beside the default --rtol; the default run stores 1e-10."""
+    from shipblock.solver import DEFAULT_ATOL
+
+    given, default = tmp_path / "given.nc", tmp_path / "default.nc"
+    common = ["simulate", "--record", "NP.1765", "--scale", "2.6", "--figure",
+              str(tmp_path / "f.png")]
+    assert run(capsys, *common, "--atol", "1e-7", "-o", str(given))[0] == 0
+    assert run(capsys, *common, "-o", str(default))[0] == 0
+    with xr.open_dataset(given) as a, xr.open_dataset(default) as b:
+        assert a.attrs["solver_atol"] == 1e-7 and b.attrs["solver_atol"] == DEFAULT_ATOL
+        assert a.attrs["solver_rtol"] == b.attrs["solver_rtol"] == 1e-8

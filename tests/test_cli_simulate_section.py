@@ -106,3 +106,19 @@ def test_a_pipelines_rigid_system_table_runs_the_rigid_model(tmp_path, records, 
     assert _simulate(tmp_path, records, "--n-blocks", "100", system=rigid) == 0
     text = capsys.readouterr().out
     assert "M = 5e+06 kg on 100 blocks of 1200 kg" in text and "peak ship slip" in text
+
+
+def test_atol_reaches_the_section_solver_and_is_checked_against_its_range(tmp_path, records,
+                                                                          capsys):
+    """--atol (with --rtol) is passed to the section model's integrator: the tolerances used
+    are stored with the response; a value outside the section model's range (at most 1e-3)
+    is refused naming the flag, not run."""
+    out = tmp_path / "tol.nc"
+    assert _simulate(tmp_path, records, "--scale", "1e-5", "--atol", "1e-8", "--rtol", "1e-7",
+                     "-o", str(out)) == 0
+    capsys.readouterr()
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["solver_atol"] == 1e-8 and ds.attrs["solver_rtol"] == 1e-7
+    assert _simulate(tmp_path, records, "--atol", "0.01") == 2
+    err = capsys.readouterr().err
+    assert "--atol must be" in err and "1e-15, 0.001" in err and "section model" in err

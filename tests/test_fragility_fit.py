@@ -563,13 +563,22 @@ def test_bootstrap_drops_unfittable_resamples_with_a_warning():
     exceeded = np.zeros((20, 2), dtype=bool)
     exceeded[0, :] = True  # the only exceedance at x = 1: resamples without it are separated
     exceeded[1:3, 1] = True
-    with pytest.warns(RuntimeWarning, match="could not be fitted"):
+    with pytest.warns(RuntimeWarning, match="could not be fitted") as said:
         result = bootstrap(fit_msa, {"exceeded": exceeded}, im_levels=x, n_boot=100, seed=0)
     assert 0 < result.n_failed < 50
     assert result.medians.size == 100 - result.n_failed
     assert np.all(np.isfinite(result.medians)) and np.all(np.isfinite(result.lower))
+    # why: each failed resample's FragilityFitError message counted, most frequent first
+    assert sum(result.failures.values()) == result.n_failed
+    counts = list(result.failures.values())
+    assert counts == sorted(counts, reverse=True)
+    reason, count = next(iter(result.failures.items()))
+    assert reason and count > 0
+    text = result.failure_text()
+    assert text == f"the most frequent reason ({count} of {result.n_failed}): {reason}"
+    assert text in str(said[0].message)
     exceeded[2, 1] = False  # only 2 exceeding records: most resamples are unfittable
-    with pytest.raises(ValueError, match="too sparse"):
+    with pytest.raises(ValueError, match="too sparse for a bootstrap; the most frequent reason"):
         bootstrap(fit_msa, {"exceeded": exceeded}, im_levels=x, n_boot=100, seed=0)
 
 

@@ -136,11 +136,15 @@ def test_format_from_the_suffix_the_flag_and_refused_by_name(demo, tmp_path, mon
     assert html[0].read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
     monkeypatch.chdir(tmp_path)
     assert main(["-q", "report", str(demo), "--format", "pdf"]) == 0
-    assert (tmp_path / "report.pdf").read_bytes().startswith(b"%PDF-")
+    # without --output, beside the results it reads and named after them; not in the cwd
+    beside = demo.with_name(f"{demo.stem}_report.pdf")
+    assert beside.read_bytes().startswith(b"%PDF-")
+    assert (demo.parent / f"{demo.stem}_report_csv" / "fragility.csv").exists()
+    assert not (tmp_path / "report.pdf").exists()
     with pytest.raises(ParameterError, match="format"):
         write_report(demo, tmp_path / "r.doc", format="docx")
     assert not list(tmp_path.glob("*.part"))
     # the same study through the API and the command line: as many pages
     a, b = (np.array(re.findall(rb"/Type /Page\b", p.read_bytes())).size
-            for p in (tmp_path / "r.pdf", tmp_path / "report.pdf"))
+            for p in (tmp_path / "r.pdf", beside))
     assert a == b

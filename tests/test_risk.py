@@ -18,7 +18,7 @@ from scipy.special import ndtr
 from shipblock.cli import main
 from shipblock.errors import ParameterError
 from shipblock.fragility.pipeline import run_pipeline
-from shipblock.plot_risk import plot_deaggregation, plot_risk
+from shipblock.plot_risk import plot_deaggregation, plot_hazard_and_fragility, plot_risk
 from shipblock.risk import (
     HazardError,
     period_probability,
@@ -430,5 +430,18 @@ def test_deaggregation_figure_shares_sum_to_100(study):
     assert stairs.get_data().values.sum() == pytest.approx(100.0, rel=1e-9)
     axes = plot_risk(risk)
     assert len(axes) == 2
+    # the hazard curve has its legend entry (it had none: the legend was the fragilities'
+    # twin axes' alone), first, in the one legend with the fragilities; its line is the curve
+    hazard_ax, twin = plot_hazard_and_fragility(risk, sweep={"mu_ship": 0.35})
+    legend = twin.get_legend()
+    labels = [t.get_text() for t in legend.get_texts()]
+    assert labels[0] == "site hazard (left axis)"
+    fitted = [str(n) for n in risk["limit_state"].values
+              if np.isfinite(risk["median"].sel(limit_state=n, mu_ship=0.35))]
+    assert labels[1:] == fitted and fitted  # a limit state not fitted is not drawn
+    (curve,) = [line for line in hazard_ax.get_lines() if line.get_label() == labels[0]]
+    positive = risk["hazard_rate"].values > 0
+    np.testing.assert_array_equal(curve.get_ydata(), risk["hazard_rate"].values[positive])
+    assert hazard_ax.get_legend() is None  # one legend, not two
     with pytest.raises(ParameterError, match="limit state 'collapse' is not in the study"):
         plot_deaggregation(risk, limit_state="collapse")

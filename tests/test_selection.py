@@ -359,3 +359,41 @@ def test_command_line_caps_records_per_earthquake(event_catalogue, tmp_path, cap
                  "--no-scale", "--no-processing", "--max-per-event", "1", "-o", str(out)]) == 2
     err = capsys.readouterr().err
     assert "max_per_event = 1 (--max-per-event)" in err and "not k = 4 (-k)" in err
+
+
+def test_command_line_takes_a_processing_chain_file_as_the_python_api(catalogue, tmp_path,
+                                                                      capsys):
+    """--processing FILE: the records' spectra are taken after the file's chain, as
+    select_records(processing=chain) does (a 2 Hz low-pass moves a1, an exact copy of the
+    target's record, off its misfit 0); with --no-processing a usage error naming both; a step
+    the chain does not know is refused naming the file and the step, before any record."""
+    target = tmp_path / "target.csv"
+    target.write_text("period [s], Sa [m/s^2]\n" + "".join(
+        f"{float(p)!r}, {float(s)!r}\n" for p, s in zip(PERIODS, TARGET_H.sa, strict=True)))
+    chain_file = tmp_path / "lowpass.toml"
+    chain_file.write_text('[[processing]]\nstep = "lowpass"\nfreq = 2.0\n')
+    out = tmp_path / "selected.toml"
+    common = ["-q", "select", str(catalogue), "--target", str(target), "-k", "1", "-o",
+              str(out), "--n-periods", str(PERIODS.size), "--ids", "syn/a1", "--no-scale",
+              "--no-suite-floor"]
+
+    def misfit(text):
+        return float(next(line for line in text.splitlines() if "syn/a1" in line).split()[3])
+
+    assert main([*common, "--no-processing"]) == 0
+    assert misfit(capsys.readouterr().out) == 0.0
+    assert main([*common, "--processing", str(chain_file)]) == 0
+    printed = misfit(capsys.readouterr().out)
+    python = select_records(catalogue, TARGET_H, 1, processing=[{"step": "lowpass", "freq": 2.0}],
+                            n_periods=PERIODS.size, ids=["syn/a1"], scale=False,
+                            suite_floor=False)
+    assert printed > 0.01 and printed == pytest.approx(python.chosen[0].misfit, abs=5e-4)
+    with pytest.raises(SystemExit) as exc:
+        main([*common, "--processing", str(chain_file), "--no-processing"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "--processing" in err and "--no-processing" in err and "not allowed" in err
+    chain_file.write_text('[[processing]]\nstep = "lopass"\nfreq = 2.0\n')
+    assert main([*common, "--processing", str(chain_file)]) == 2
+    err = capsys.readouterr().err
+    assert str(chain_file) in err and "processing[0].step" in err and "'lopass'" in err

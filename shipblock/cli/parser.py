@@ -65,11 +65,20 @@ def build_parser():
     g.add_argument("--target-pga", metavar="PGA",
                    help="scale to this PGA of the horizontal, with its unit: 0.4g, 3.9m/s^2, "
                         "392gal (the vertical by the same factor unless --vertical-scale)")
-    g.add_argument("--vertical-scale", type=float, help="independent factor on the vertical")
-    g.add_argument("--no-vertical", action="store_true", help="ignore the vertical component")
+    # one or the other: a factor on a vertical that is dropped would be ignored without a word
+    vertical = g.add_mutually_exclusive_group()
+    vertical.add_argument("--vertical-scale", type=float,
+                          help="independent factor on the vertical (not with --no-vertical)")
+    vertical.add_argument("--no-vertical", action="store_true",
+                          help="ignore the vertical component (not with --vertical-scale)")
     g.add_argument("--rtol", type=float,
                    help="relative tolerance of the integration (default: 1e-8 for the rigid "
                         "model's rocking phases, the section model's own otherwise)")
+    g.add_argument("--atol", type=float,
+                   help="absolute tolerance of the integration, in the unit of each state: m "
+                        "and m/s for displacements and velocities, rad and rad/s for rotations "
+                        "(default: 1e-10 for the rigid model's rocking phases, the section "
+                        "model's own, 1e-9, otherwise); checked against the model's range")
     g.add_argument("--output", "-o", help="NetCDF file for the response")
     g.add_argument("--figure", help="PNG for the response figure (default: next to --output)")
     g.add_argument("--events", type=int, default=20, help="list at most this many events")
@@ -204,8 +213,15 @@ def build_parser():
     s.add_argument("--no-scale", action="store_true", help="compare the records unscaled")
     s.add_argument("--min-scale-factor", type=float, default=0.25, help="default 0.25")
     s.add_argument("--max-scale-factor", type=float, default=4.0, help="default 4")
-    s.add_argument("--no-processing", action="store_true",
-                   help="spectra of the records as read (default: the default processing chain)")
+    chain = s.add_mutually_exclusive_group()
+    chain.add_argument("--no-processing", action="store_true",
+                       help="spectra of the records as read (default: the default processing "
+                            "chain; not with --processing)")
+    chain.add_argument("--processing", metavar="FILE",
+                       help="processing chain before the spectra: a TOML file with "
+                            "[[processing]] steps, as a pipeline's (checked before any record "
+                            "is read), or 'default', 'demean', 'none' as for simulate (not "
+                            "with --no-processing)")
     s.add_argument("--ids", nargs="+", action="extend", metavar="ID",
                    help="only these catalogue records (default: all), e.g. --ids NP.1765 "
                         "NP.1764")
@@ -256,8 +272,9 @@ def build_parser():
     s.add_argument("--format", choices=["html", "pdf"],
                    help="html (one self-contained file) or pdf (A4 pages, the same content); "
                         "default: from the suffix of --output, else html")
-    s.add_argument("--output", "-o", help="file to write (default report.html, or report.pdf "
-                                          "with --format pdf)")
+    s.add_argument("--output", "-o",
+                   help="file to write (default: <results stem>_report.html beside the results, "
+                        "or _report.pdf with --format pdf)")
     s.set_defaults(func=cmd_report)
 
     s = sub.add_parser("bench", help="benchmarks: runs/s, campaign time and memory, pySLAMMER, "

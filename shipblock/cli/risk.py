@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from shipblock.cli._common import _save_figure
+from shipblock.cli.reading import _processing_chain
 
 
 def cmd_risk(args):
@@ -36,6 +37,7 @@ def cmd_select(args):
     )
 
     entries = load_catalogue(args.catalogue)
+    processing = [] if args.no_processing else _selection_chain(args.processing)
     target = target_from_file(args.target, args.units)
     vertical = (None if args.vertical_target is None
                 else target_from_file(args.vertical_target, args.vertical_units or args.units))
@@ -44,7 +46,7 @@ def cmd_select(args):
         vertical_weight=args.vertical_weight, scale=not args.no_scale,
         min_scale_factor=args.min_scale_factor, max_scale_factor=args.max_scale_factor,
         horizontal=args.horizontal, azimuth=args.azimuth,
-        processing=[] if args.no_processing else None, max_per_event=args.max_per_event,
+        processing=processing, max_per_event=args.max_per_event,
         damping=args.damping, n_periods=args.n_periods, ids=args.ids,
         suite_floor=not args.no_suite_floor)
     output = Path(args.output)
@@ -61,3 +63,17 @@ def cmd_select(args):
     for line in selection_lines(selection):
         sys.stdout.write(line + "\n")
     return 0
+
+
+def _selection_chain(spec):
+    """The chain of ``select --processing`` (None: the default chain): a file's steps checked
+    as a pipeline's are, an error naming the file and the step, before any record is read
+    (else every record would fail alike, one by one)."""
+    from shipblock.fragility.schema import _processing
+
+    if spec is None:
+        return None
+    chain = _processing_chain(spec)
+    if spec not in ("default", "none", "demean"):
+        _processing({"processing": chain}, f"--processing {spec}")
+    return chain

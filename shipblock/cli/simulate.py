@@ -37,6 +37,9 @@ def _scaled_input(args, motion):
     from shipblock.scaling import acceleration_target, scale_record
 
     vertical = None if args.no_vertical else motion.vertical
+    if vertical is None and args.vertical_scale is not None:  # else dropped without a word
+        raise UserError(f"--vertical-scale {args.vertical_scale:g}: the record "
+                        f"{motion.name} has no vertical component")
     if args.target_pga is None:
         factor = 1.0 if args.scale is None else args.scale
         ax = motion.horizontal * factor
@@ -59,6 +62,23 @@ def _scaled_input(args, motion):
 
 #: --rtol of a rigid-model run when not given (the section model has its own default).
 RIGID_RTOL = 1e-8
+
+
+def _solver_options(args, model) -> dict:
+    """``--rtol`` and ``--atol`` as given, each checked against the range ``model`` declares
+    for its ``[solver]`` option; a value outside it is an error naming the flag."""
+    from shipblock.models.base import FieldError
+
+    options = {}
+    for name in ("rtol", "atol"):
+        value = getattr(args, name)
+        if value is None:
+            continue
+        try:
+            options[name] = model.options[name].check(value, f"--{name}")
+        except FieldError as exc:
+            raise UserError(f"--{name} {exc.problem} (the {model.name} model's range)") from None
+    return options
 
 
 def _model_system(args):
@@ -95,7 +115,7 @@ def cmd_simulate(args):
     from shipblock.plot import record_text
     from shipblock.solver import simulate
 
-    from shipblock.models import DEFAULT_MODEL
+    from shipblock.models import DEFAULT_MODEL, get_model
 
     chosen = _model_system(args)
     if chosen is None or chosen[0].name == DEFAULT_MODEL:
@@ -109,17 +129,18 @@ def cmd_simulate(args):
     sys.stdout.write(f"horizontal  {_horizontal_line(motion)}\n")
     name = motion.name
     record = record_text(motion, scale)
+    model = get_model(DEFAULT_MODEL) if chosen is None else chosen[0]
+    options = _solver_options(args, model)
     if chosen is not None:
-        model = chosen[0]
-        options = {} if args.rtol is None else {"rtol": args.rtol}
         res = model.simulate(system, ax, ay, motion.dt, **options)
         _section_report(model, system, res, name, args.events)
     else:
-        res = simulate(system, ax, ay, motion.dt,
-                       rtol=RIGID_RTOL if args.rtol is None else args.rtol)
+        res = simulate(system, ax, ay, motion.dt, **{"rtol": RIGID_RTOL, **options})
         _report(res, name, args.events)
     if args.output:
         ds = res.to_dataset()
+        for key in ("rtol", "atol"):  # the tolerances used (a rigid result states its own)
+            ds.attrs.setdefault(f"solver_{key}", options.get(key, model.options[key].default))
         ds.attrs["record"] = str(name)
         ds.attrs["record_description"] = record
         ds.attrs["processing"] = "\n".join(motion.metadata.get("processing", []) or [])

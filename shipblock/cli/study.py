@@ -182,7 +182,8 @@ def cmd_report(args):
     from shipblock.risk.selection import target_from_file
 
     target = None if args.target is None else target_from_file(args.target, args.units)
-    output = args.output or f"report.{args.format or 'html'}"
+    results = Path(args.results)  # by default the report goes beside it, as risk's file does
+    output = args.output or results.with_name(f"{results.stem}_report.{args.format or 'html'}")
     written = write_report(args.results, output, hazard_results=args.hazard_results,
                            target=target, period_range=args.period_range, format=args.format)
     sys.stdout.write(f"report written to {written[0]}\n")

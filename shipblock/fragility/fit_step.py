@@ -42,7 +42,7 @@ def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng, workers=None):
     """Fit one limit state for one parameter combination; returns a dict of results."""
     out = {"median": np.nan, "beta": np.nan, "median_lower": np.nan, "median_upper": np.nan,
            "beta_lower": np.nan, "beta_upper": np.nan, "fit_method": "", "fit_error": "",
-           "n_fit_records": 0, "bootstrap_failed": 0}
+           "n_fit_records": 0, "bootstrap_failed": 0, "bootstrap_failure": ""}
     keep = w.any(axis=1) if e.ndim == 2 else w
     out["n_fit_records"] = int(keep.sum())
     capacity = None
@@ -75,7 +75,7 @@ def _fit_one(kind, e, w, levels, im, edp, ls, fit_opts, rng, workers=None):
                                   seed=rng, workers=workers, **kw)
                 out.update(median_lower=b.fit.median_ci[0], median_upper=b.fit.median_ci[1],
                            beta_lower=b.fit.beta_ci[0], beta_upper=b.fit.beta_ci[1],
-                           bootstrap_failed=b.n_failed)
+                           bootstrap_failed=b.n_failed, bootstrap_failure=b.failure_text())
             except ValueError as exc:
                 out["fit_error"] = f"bootstrap: {exc}"
     except (FragilityFitError, ValueError) as exc:
@@ -123,7 +123,8 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
     dict
         Name -> :class:`xarray.DataArray` with ``units`` and ``long_name``: ``exceeded`` and
         ``valid`` on ``(limit_state, *design.dims)``; ``median``, ``beta``, their bounds,
-        ``fit_method``, ``fit_error``, ``n_fit_records``, ``bootstrap_failed`` on
+        ``fit_method``, ``fit_error``, ``n_fit_records``, ``bootstrap_failed``,
+        ``bootstrap_failure`` on
         ``(limit_state, *sweep)``; ``ida_capacity`` and ``ida_capacity_lower`` (the first
         level that failed and the last that held) on ``(limit_state, record, *sweep)`` for
         IDA. Bootstrap resampling of combination ``c`` of limit state ``i`` is seeded with
@@ -145,6 +146,7 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
     fields["bootstrap_failed"] = np.zeros((n_ls, *sweep_shape), dtype=np.int64)
     fields["fit_method"] = np.full((n_ls, *sweep_shape), "", dtype=object)
     fields["fit_error"] = np.full((n_ls, *sweep_shape), "", dtype=object)
+    fields["bootstrap_failure"] = np.full((n_ls, *sweep_shape), "", dtype=object)
     n_records = len(design.records)
     capacity = np.full((n_ls, n_records, *sweep_shape), np.nan)
     capacity_held = capacity.copy()
@@ -170,8 +172,9 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
                                      ls, fit_opts, rng, workers)
                 for k in ("median", "median_lower", "median_upper"):
                     res[k] *= factor  # back to SI
-                if res["fit_error"]:
-                    res["fit_error"] += f" [IM in {unit}]"
+                for k in ("fit_error", "bootstrap_failure"):  # the fits' messages quote levels
+                    if res[k]:
+                        res[k] += f" [IM in {unit}]"
                 col = np.full(n_records, np.nan)
                 col_held = np.full(n_records, np.nan)
                 if caps is not None:
@@ -200,6 +203,9 @@ def fragility_variables(ds: xr.Dataset, design: AnalysisDesign, limit_states, fi
         "fit_error": ("1", "why the fit (or its bootstrap) failed (empty if it did not)"),
         "n_fit_records": ("1", "number of records with at least one valid run"),
         "bootstrap_failed": ("1", "bootstrap resamples that could not be fitted"),
+        "bootstrap_failure": ("1", "why bootstrap resamples could not be fitted: the most "
+                                   "frequent reason, after how many of the failed gave it "
+                                   "(empty if none failed)"),
     }
     out = {}
     for k, (units, long_name) in info.items():

@@ -91,6 +91,21 @@ def _median_text(ds, sel, factor) -> tuple[str, str]:
     return f"{median:.3g}", band
 
 
+def _bootstrap_text(ds: xr.Dataset, sel) -> str:
+    """``"66 of 200 bootstrap resamples could not be fitted, left out of the band; the most
+    frequent reason (48 of 66): ..."`` for a fit whose bootstrap lost resamples, else ``""``."""
+    if "bootstrap_failed" not in ds:
+        return ""
+    n_failed = int(ds["bootstrap_failed"].sel(sel))
+    if n_failed <= 0:
+        return ""
+    n_boot = ds["median_lower"].attrs.get("n_bootstrap") if "median_lower" in ds else None
+    text = (f"{n_failed}{f' of {int(n_boot)}' if n_boot else ''} bootstrap resamples could not "
+            "be fitted, left out of the band")
+    why = str(ds["bootstrap_failure"].sel(sel).values) if "bootstrap_failure" in ds else ""
+    return text + (f"; {why}" if why else "")
+
+
 def fit_lines(ds: xr.Dataset) -> list[str]:
     """The fitted curves: one line per limit state, or a table over the swept parameters.
 
@@ -130,6 +145,8 @@ def fit_lines(ds: xr.Dataset) -> list[str]:
                          f"{float(ds['beta'].sel(sel)):.3f}")
             if error:
                 lines.append(f"  {'':<24} ({error})")
+            if boot := _bootstrap_text(ds, sel):
+                lines.append(f"  {'':<24} ({boot})")
             continue
         lines.append(f"  {name}:")
         units = [swept_unit(ds, d) for d in sweep]
@@ -137,6 +154,7 @@ def fit_lines(ds: xr.Dataset) -> list[str]:
         header += ["median", "band", "beta"]
         rows = []
         notes = []
+        boot_notes = []
         for combo in itertools.product(*(ds[d].values for d in sweep)):
             sel = {"limit_state": ls, **dict(zip(sweep, combo, strict=True))}
             values = [f"{v:g}" if isinstance(v, int | float | np.number) else str(v)
@@ -150,11 +168,16 @@ def fit_lines(ds: xr.Dataset) -> list[str]:
                 notes.append(f"{where}: {error.split(': ', 1)[-1]}")
             else:
                 rows.append([*values, median, band, f"{float(ds['beta'].sel(sel)):.3f}"])
+                if boot := _bootstrap_text(ds, sel):
+                    where = ", ".join(f"{d} = {v}{f' {u}' if u else ''}"
+                                      for d, v, u in zip(sweep, values, units, strict=True))
+                    boot_notes.append(f"{where}: {boot}")
         widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
         lines.append("    " + "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)).rstrip())
         for r in rows:
             lines.append("    " + "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip())
         lines += [f"    not fitted at {n}" for n in notes]
+        lines += [f"    bootstrap at {n}" for n in boot_notes]
     return lines
 
 

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import time
 import warnings
+from collections import Counter
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -49,6 +50,9 @@ class BootstrapResult:
         Number of resamples whose refit raised :class:`FragilityFitError` (e.g. a resample with no
         exceedance); they are left out of the percentiles, which therefore condition on
         identifiable resamples.
+    failures : dict of str to int
+        Why they could not be refitted: the :class:`FragilityFitError` message -> how many
+        resamples raised it, most frequent first (empty when none failed).
     """
 
     fit: FragilityFit
@@ -58,6 +62,20 @@ class BootstrapResult:
     medians: np.ndarray
     betas: np.ndarray
     n_failed: int
+    failures: dict = field(default_factory=dict)
+
+    def failure_text(self) -> str:
+        """The most frequent reason a resample could not be refitted, with how many of the
+        failed resamples gave it: ``"the most frequent reason (48 of 66): every record's
+        ..."`` (``""`` if none failed)."""
+        return _failure_text(self.failures, self.n_failed)
+
+
+def _failure_text(failures: Mapping[str, int], n_failed: int) -> str:
+    if not failures:
+        return ""
+    reason, count = next(iter(failures.items()))
+    return f"the most frequent reason ({count} of {n_failed}): {reason}"
 
 
 def bootstrap(
@@ -166,18 +184,24 @@ def bootstrap(
             items = [(fit_function, arrays, fit_kwargs, rest[b.start:b.stop])
                      for b in blocks(len(rest), workers.slots())]
             parts += workers.map(_bootstrap_block, items, estimated_seconds=estimate)
-    fitted = np.concatenate(parts, axis=1) if parts else np.zeros((2, 0))
+    fitted = np.concatenate([p[0] for p in parts], axis=1) if parts else np.zeros((2, 0))
+    reasons = Counter()
+    for _, part_reasons in parts:
+        reasons.update(part_reasons)
     ok = np.isfinite(fitted[0])
     medians, betas = fitted[0, ok].tolist(), fitted[1, ok].tolist()
     n_failed = int(np.count_nonzero(~ok))
+    failures = dict(reasons.most_common())
+    why = f"; {_failure_text(failures, n_failed)}" if failures else ""
     if len(medians) < max(2, n_boot / 2):
         raise ParameterError(
             f"only {len(medians)} of {n_boot} bootstrap refits succeeded; the data are too "
-            "sparse for a bootstrap"
+            f"sparse for a bootstrap{why}"
         )
     if n_failed:
         warnings.warn(
-            f"{n_failed} of {n_boot} bootstrap resamples could not be fitted and were dropped",
+            f"{n_failed} of {n_boot} bootstrap resamples could not be fitted and were "
+            f"dropped{why}",
             RuntimeWarning,
             stacklevel=2,
         )
@@ -199,6 +223,7 @@ def bootstrap(
         medians=medians,
         betas=betas,
         n_failed=n_failed,
+        failures=failures,
     )
 
 
@@ -213,22 +238,25 @@ def _replicate_seeds(seed, n_boot: int) -> list:
     return sequence.spawn(n_boot)
 
 
-def _bootstrap_block(fit_function, arrays, fit_kwargs, seeds) -> np.ndarray:
-    """Medians and betas of the replicates with these seeds: shape (2, len(seeds)), NaN if unfittable.
+def _bootstrap_block(fit_function, arrays, fit_kwargs, seeds) -> tuple[np.ndarray, dict]:
+    """Medians and betas of the replicates with these seeds: shape (2, len(seeds)), NaN if
+    unfittable; and why those were not (the :class:`FragilityFitError` message -> count).
 
     A pure function of its arguments (a task for local processes or Dask): replicate ``k``
     resamples the records with ``numpy.random.default_rng(seeds[k])``.
     """
     n_rec = next(iter(arrays.values())).shape[0]
     out = np.full((2, len(seeds)), np.nan)
+    reasons = {}
     for k, child in enumerate(seeds):
         idx = np.random.default_rng(child).integers(0, n_rec, size=n_rec)
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)
                 f = fit_function(**{name: a[idx] for name, a in arrays.items()}, **fit_kwargs)
-        except FragilityFitError:
+        except FragilityFitError as exc:
+            reasons[str(exc)] = reasons.get(str(exc), 0) + 1
             continue
         out[0, k], out[1, k] = f.median, f.beta
-    return out
+    return out, reasons
 

@@ -27,7 +27,7 @@ FIT_CHECKPOINT_INTERVAL = 1.0
 
 _FIT_FLOATS = ("median", "beta", "median_lower", "median_upper", "beta_lower", "beta_upper")
 _FIT_INTS = ("n_fit_records", "bootstrap_failed")
-_FIT_STRINGS = ("fit_method", "fit_error")
+_FIT_STRINGS = ("fit_method", "fit_error", "bootstrap_failure")
 #: The results of one fit, in the order they are stored.
 FIT_FIELDS = _FIT_FLOATS + _FIT_INTS + _FIT_STRINGS
 
