@@ -131,6 +131,14 @@ def dense(r, theta, out):
 
 
 @njit(cache=True)
+def _force_arrays(nsp, ns):
+    """Work arrays of the springs' and strips' kinematics and forces (:func:`kinematics`,
+    :func:`contact_forces`): delta, delta_dot, vt, pos, fe, fn, normal, tang."""
+    return (np.zeros(nsp), np.zeros(nsp), np.zeros(ns), np.zeros((nsp, 2)), np.zeros(nsp),
+            np.zeros(nsp), np.zeros(ns), np.zeros(ns))
+
+
+@njit(cache=True)
 def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f, opt, theta_c, ag_y, ag_z,
         dt_rec, t_end, rtol, atol, h_max, max_events, hist_x, hist_n, hist_t, ev_t, ev_kind,
         ev_index, acc, peak_fe, peak_fn, peak_util, peak_n):
@@ -147,14 +155,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     nx = x.shape[0]
     n_err = 6 * nb + ns
     ng = 2 * nsp + ns + (nb - 1) + 4
-    delta = np.zeros(nsp)
-    delta_dot = np.zeros(nsp)
-    vt = np.zeros(ns)
-    pos = np.zeros((nsp, 2))
-    fe = np.zeros(nsp)
-    fn = np.zeros(nsp)
-    normal = np.zeros(ns)
-    tang = np.zeros(ns)
+    delta, delta_dot, vt, pos, fe, fn, normal, tang = _force_arrays(nsp, ns)
     k1 = np.zeros(nx)
     k2 = np.zeros(nx)
     k3 = np.zeros(nx)
@@ -172,14 +173,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     sums = np.zeros((ns, N_RS))
     # peaks inside a step: forces on the dense output (their own work arrays) and the strips'
     # normal forces at the step's start
-    m_delta = np.zeros(nsp)
-    m_delta_dot = np.zeros(nsp)
-    m_vt = np.zeros(ns)
-    m_pos = np.zeros((nsp, 2))
-    m_fe = np.zeros(nsp)
-    m_fn = np.zeros(nsp)
-    m_normal = np.zeros(ns)
-    m_tang = np.zeros(ns)
+    m_delta, m_delta_dot, m_vt, m_pos, m_fe, m_fn, m_normal, m_tang = _force_arrays(nsp, ns)
     n_start = np.zeros(ns)
     stage_n = np.zeros(ns)  # the largest normal force of each strip at the step's stages
     t = 0.0
@@ -451,11 +445,14 @@ def _track_inside(hi, r, stage_n, nb, ns, nsp, strip_f, strip_i, spring_f, reg, 
     impact lies inside a step; at the step ends alone it was missed by up to ~16 %.
 
     Only a step where a strip's normal force at one of the stages (``stage_n``) exceeds its
-    values at both ends is looked into: elsewhere the force is monotone or flat over the
-    step to the integration's accuracy."""
+    values at both ends and 90 % of its peak so far is looked into: elsewhere the force is
+    monotone over the step to the integration's accuracy, or too far below its peak to set a
+    new one (a stage's force is a lower-order estimate: the margin covers its error). On the
+    benchmark 9 % of the steps are looked into (53 % without the second condition), with the
+    same peaks."""
     inside = False
     for j in range(ns):
-        if stage_n[j] > max(n_start[j], n_end[j]):
+        if stage_n[j] > max(n_start[j], n_end[j], 0.9 * peak_n[j]):
             inside = True
     if not inside:
         return
