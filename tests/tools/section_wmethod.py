@@ -155,6 +155,7 @@ def _jacobian(t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, o
     ``stage_rhs`` at ``x``. Returns the number of evaluations."""
     o_e = 6 * nb + ns
     n_eval = 0
+    stage_n = np.zeros(ns)  # stage_rhs's strip forces (not used here)
     for colour in range(gcol.max() + 1):
         width = 0
         for g in range(gidx.shape[0]):
@@ -168,7 +169,7 @@ def _jacobian(t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, o
                     m = gidx[g, p]
                     xp[m] = x[m] + 1e-8 * max(abs(x[m]), 1e-3)
             stage_rhs(t, xp, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
-                      ag_z, dt_rec, sums, fp, np.zeros(ns))
+                      ag_z, dt_rec, sums, fp, stage_n)
             n_eval += 1
             for g in range(gidx.shape[0]):
                 if gcol[g] == colour and p < gsize[g]:
@@ -310,6 +311,7 @@ def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_
     states (``6 n_b + n_s`` as in the kernel, or all: also the energy integrals); and ``cnt``:
     Jacobians, their evaluations, factorisations)."""
     ns = strip_i.shape[0]
+    stage_n = np.zeros(ns)  # stage_rhs's strip forces (not used here)
     nsp = spring_f.shape[0]
     nx = x.shape[0]
     n_err = 6 * nb + ns
@@ -390,7 +392,7 @@ def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_
             break
         if stale:
             stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y,
-                      ag_z, dt_rec, sums, f0, np.zeros(ns))
+                      ag_z, dt_rec, sums, f0, stage_n)
             cnt[1] += _jacobian(t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs,
                                 opt, ag_y, ag_z, dt_rec, sums, gidx, gsize, gcol, jac, jace, y,
                                 fp)
@@ -428,7 +430,7 @@ def run_w(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_
                     y[m] = sy
                     b[m] = sb / h
                 stage_rhs(t + tt[i] * h, y, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs,
-                          opt, ag_y, ag_z, dt_rec, sums, fst, np.zeros(ns))
+                          opt, ag_y, ag_z, dt_rec, sums, fst, stage_n)
                 for m in range(nx):
                     b[m] += fst[m]
             if tg[i] != 0.0:
@@ -653,10 +655,11 @@ def _repeat(part, n, t, x, f0, nb, ns, mass, inertia, strip_f, strip_i, spring_f
     delta, delta_dot, vt = np.zeros(nsp), np.zeros(nsp), np.zeros(ns)
     pos, fe, fn = np.zeros((nsp, 2)), np.zeros(nsp), np.zeros(nsp)
     normal, tang = np.zeros(ns), np.zeros(ns)
+    stage_n = np.zeros(ns)  # stage_rhs's strip forces (not used here)
     for _ in range(n):
         if part == 0:
             stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, ag_y, ag_z,
-                      dt_rec, sums, out, np.zeros(ns))
+                      dt_rec, sums, out, stage_n)
         elif part == 1:
             rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y,
                 ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, out)
