@@ -35,7 +35,7 @@ EV_END = 20
 
 # --- running totals (acc) ------------------------------------------------------------------------
 A_FRIC_EVENT, A_CAP_RELAX = 0, 1
-N_ACC = 2
+N_ACC = 4
 
 BIG = 1e300
 
@@ -288,6 +288,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             if g1[q] <= 0.0 and (g0[q] > 0.0 or (g0[q] == 0.0 and _is_gap(q, nsp, reg))):
                 a, b, ga, gb = 0.0, 1.0, g0[q], g1[q]
                 if first >= 0:
+                    acc[3] += 1.0
                     # only look before the earliest one found so far
                     dense(r, hi, xe)
                     event_values(t + hi * h, xe, nb, ns, strip_f, strip_i, spring_f, reg, dp,
@@ -305,6 +306,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
                     # stay strictly inside, and bisect when the secant hugs an end
                     if not (a + 0.01 * (b - a) < mid < b - 0.01 * (b - a)):
                         mid = min(max(mid, a + 0.01 * (b - a)), b - 0.01 * (b - a))
+                    acc[2] += 1.0
                     dense(r, mid, xe)
                     event_values(t + mid * h, xe, nb, ns, strip_f, strip_i, spring_f, reg, dp,
                                  dc0, tc0, fs, opt, delta, delta_dot, vt, pos, fe, fn, normal,
