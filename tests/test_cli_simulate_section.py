@@ -122,3 +122,23 @@ def test_atol_reaches_the_section_solver_and_is_checked_against_its_range(tmp_pa
     assert _simulate(tmp_path, records, "--atol", "0.01") == 2
     err = capsys.readouterr().err
     assert "--atol must be" in err and "1e-15, 0.001" in err and "section model" in err
+
+
+def test_no_exponential_steps_reaches_the_section_solver(tmp_path, records, capsys):
+    """--no-exponential-steps runs Dormand-Prince throughout: the same keel load to the
+    tolerance, stored as solver_exponential_steps = 0 (1 by default); refused, naming the flag,
+    for the rigid model."""
+    loads = {}
+    for flag, stored in (((), 1), (("--no-exponential-steps",), 0)):
+        out = tmp_path / f"run{stored}.nc"
+        assert _simulate(tmp_path, records, "--scale", "0.5", *flag, "-o", str(out)) == 0
+        capsys.readouterr()
+        with xr.open_dataset(out) as ds:
+            assert ds.attrs["solver_exponential_steps"] == stored
+            loads[stored] = float(ds["keel_top_normal"].max())
+    assert loads[0] == pytest.approx(loads[1], rel=1e-4)
+    rigid = ('[system]\nmodel = "rigid"\nship_mass = "5000 t"\nblock_mass = "1.2 t"\n'
+             'n_blocks = 150\nhalf_width = 0.3\nhalf_height = 0.6\nmu_s_ground = 0.6\n'
+             'mu_k_ground = 0.55\nmu_s_ship = 0.35\nmu_k_ship = 0.3\n')
+    assert _simulate(tmp_path, records, "--no-exponential-steps", system=rigid) == 2
+    assert "--no-exponential-steps applies to the section model" in capsys.readouterr().err

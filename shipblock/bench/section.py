@@ -49,15 +49,20 @@ def record(duration=40.0, dt=0.005, pga=0.4, seed=2014):
 
 def section_speed(repeats=5) -> dict:
     """CPU time [s] per run of the section and rigid solvers on :func:`record` (best of
-    ``repeats``, compiled first), with the section run's step and event counts."""
+    ``repeats``, compiled first), with the section run's step and event counts; the section
+    also with Dormand-Prince throughout (``exponential_steps=False``), interleaved with the
+    default runs so that both see the same load."""
     dock = navy_dock()
     h, v, dt = record()
     simulate_section(dock, h[:400], v[:400], dt)  # compile
-    times = []
+    times, dopri_times = [], []
     for _ in range(repeats):
         t0 = time.process_time()
         res = simulate_section(dock, h, v, dt)
         times.append(time.process_time() - t0)
+        t0 = time.process_time()
+        dopri = simulate_section(dock, h, v, dt, exponential_steps=False)
+        dopri_times.append(time.process_time() - t0)
     keel = NAVY_BLOCK
     rigid = ShipBlockSystem(ship_mass=dock.ship.mass, block_mass=keel.block_mass, n_blocks=4,
                             half_width=keel.half_width, half_height=keel.half_height,
@@ -74,7 +79,11 @@ def section_speed(repeats=5) -> dict:
         "ratio": min(times) / min(rigid_times),
         "accepted_steps": res.stats["accepted_steps"],
         "rejected_steps": res.stats["rejected_steps"],
+        "exponential_steps": res.stats["exponential_steps"],
         "events": res.stats["events"],
+        "section_dopri_seconds_per_run": min(dopri_times),
+        "dopri_accepted_steps": dopri.stats["accepted_steps"],
+        "dopri_rejected_steps": dopri.stats["rejected_steps"],
         "energy_residual": res.energy["residual"],
         "failure": res.failure,
     }

@@ -79,6 +79,10 @@ def build_parser():
                         "and m/s for displacements and velocities, rad and rad/s for rotations "
                         "(default: 1e-10 for the rigid model's rocking phases, the section "
                         "model's own, 1e-9, otherwise); checked against the model's range")
+    g.add_argument("--no-exponential-steps", dest="exponential_steps", action="store_false",
+                   help="section model: Dormand-Prince throughout, not one exponential step per "
+                        "sample while the dock is in its static regime (slower, the same "
+                        "response to the tolerance)")
     g.add_argument("--output", "-o", help="NetCDF file for the response")
     g.add_argument("--figure", help="PNG for the response figure (default: next to --output)")
     g.add_argument("--events", type=int, default=20, help="list at most this many events")

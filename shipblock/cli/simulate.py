@@ -78,6 +78,11 @@ def _solver_options(args, model) -> dict:
             options[name] = model.options[name].check(value, f"--{name}")
         except FieldError as exc:
             raise UserError(f"--{name} {exc.problem} (the {model.name} model's range)") from None
+    if not args.exponential_steps:
+        if "exponential_steps" not in model.options:
+            raise UserError(f"--no-exponential-steps applies to the section model; this is a "
+                            f"{model.name!r} system")
+        options["exponential_steps"] = False
     return options
 
 
@@ -141,6 +146,8 @@ def cmd_simulate(args):
         ds = res.to_dataset()
         for key in ("rtol", "atol"):  # the tolerances used (a rigid result states its own)
             ds.attrs.setdefault(f"solver_{key}", options.get(key, model.options[key].default))
+        if "exponential_steps" in model.options:
+            ds.attrs["solver_exponential_steps"] = int(options.get("exponential_steps", True))
         ds.attrs["record"] = str(name)
         ds.attrs["record_description"] = record
         ds.attrs["processing"] = "\n".join(motion.metadata.get("processing", []) or [])

@@ -13,7 +13,9 @@ from shipblock.section.parameters import (
     Ship,
     Wind,
 )
-from shipblock.section.simulate import SectionResult, simulate_section, simulate_section_batch
+from shipblock.section.simulate import (SectionResult, SectionRunner, simulate_section,
+                                        simulate_section_batch)
 
 __all__ = ["LONG_TON_FORCE", "NAVY_BLOCK", "Block", "BlockLine", "Cap", "DockSection",
-           "SectionResult", "Ship", "Wind", "simulate_section", "simulate_section_batch"]
+           "SectionResult", "SectionRunner", "Ship", "Wind", "simulate_section",
+           "simulate_section_batch"]

@@ -1,7 +1,10 @@
 """Compiled kernel of the dock-section model: events and the event-driven integrator.
 
 The equations of motion and the contact laws are :mod:`shipblock.section._forces` (their
-layout constants and functions are re-exported here, the name callers use).
+layout constants and functions are re-exported here, the name callers use), the event
+functions and peaks :mod:`shipblock.section._events`, the exponential steps of the static
+regime :mod:`shipblock.section._static` (numba's cache of :func:`run` holds them compiled in:
+after editing one of those modules, touch this one).
 
 Integrator: Dormand-Prince 5(4) with Hairer's 4th-order dense output; events (a spring
 closing, detaching, starting or ending to crush; a strip sticking, slipping; failures) are
@@ -26,6 +29,8 @@ from shipblock.section._forces import (  # the layout and laws, also for K.<name
     R_FREE, SF_CT, SF_CY, SF_CZ, SF_KT, SF_MUK, SF_MUS, SF_PA, SF_PY, SF_PZ, SF_SNY, SF_SNZ,
     SF_SQY, SF_SQZ, SI_C, SI_COUNT, SI_FIRST, SI_S, cap_surface, contact_forces, kinematics,
     regime_sums, rhs, stage_rhs)
+from shipblock.section._events import BIG, _event_values_of, _is_gap, _track, event_values
+from shipblock.section._static import STATIC_PAUSE, _in_static, _static_inside, _static_step
 
 # --- event kinds (codes in the event log) -------------------------------------------------
 EV_START, EV_CLOSE, EV_DETACH, EV_CRUSH, EV_UNLOAD, EV_SLIP, EV_STICK = 0, 1, 2, 3, 4, 5, 6
@@ -35,75 +40,7 @@ EV_END = 20
 
 # --- running totals (acc) ------------------------------------------------------------------------
 A_FRIC_EVENT, A_CAP_RELAX = 0, 1
-N_ACC = 4
-
-BIG = 1e300
-
-
-@njit(cache=True)
-def event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
-                 delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, gv):
-    """Event functions of the current regimes: an event happens when one goes from > 0 to <= 0."""
-    kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
-    contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
-                   delta_dot, vt, fe, fn, normal, tang)
-    _event_values_of(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
-                     delta, delta_dot, vt, fe, fn, normal, tang, theta_c, gv)
-
-
-@njit(cache=True)
-def _event_values_of(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
-                     delta, delta_dot, vt, fe, fn, normal, tang, theta_c, gv):
-    """:func:`event_values` from the kinematics and contact forces of ``x`` already in the work
-    arrays (after :func:`rhs` at the same state and regimes)."""
-    nsp = spring_f.shape[0]
-    min_gap = BIG
-    for j in range(ns):
-        first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
-        for i in range(first, first + count):
-            k, c = spring_f[i, PF_K], spring_f[i, PF_C]
-            if reg[i] == R_FREE:
-                gv[2 * i] = cap_surface(k, c, dp[i], dc0[i], tc0[i], t) - delta[i]
-                gv[2 * i + 1] = BIG
-            elif reg[i] == R_ELASTIC:
-                gv[2 * i] = fn[i] / k  # detaches when the force would pull
-                gv[2 * i + 1] = (spring_f[i, PF_FY] - fe[i]) / k  # starts to crush
-            else:
-                gv[2 * i] = delta_dot[i]  # stops crushing when it unloads
-                gv[2 * i + 1] = BIG
-            if strip_i[j, SI_S] == 0:
-                min_gap = min(min_gap, dp[i] - delta[i])
-        if fs[j] == F_STICK:
-            gv[2 * nsp + j] = (strip_f[j, SF_MUS] * normal[j] - abs(tang[j])) / strip_f[j, SF_KT]
-        elif fs[j] == F_FREE:
-            gv[2 * nsp + j] = BIG
-        else:
-            gv[2 * nsp + j] = fs[j] * vt[j]
-    o = 2 * nsp + ns
-    for b in range(1, nb):
-        gv[o + b - 1] = theta_c[b] - abs(x[3 * b + 2])
-    o += nb - 1
-    # ship slid off the keel line's top: keel centre vs the keel block's top centre
-    ca, sa = math.cos(x[2]), math.sin(x[2])
-    ky = x[0] + ca * opt[O_SHIP_KY] - sa * opt[O_SHIP_KZ]
-    cb, sb = math.cos(x[5]), math.sin(x[5])
-    ty = x[3] + cb * opt[O_KEEL_TOP_Y] - sb * opt[O_KEEL_TOP_Z]
-    gv[o] = opt[O_KEEL_B] - abs(ky - ty)
-    phi = x[2]
-    gv[o + 1] = opt[O_TIP_POS] - phi if phi >= 0.0 else opt[O_TIP_NEG] + phi
-    gv[o + 2] = opt[O_SEP] - min_gap
-    # validity: displacements (from the body's place as built: G's offset for the ship, the
-    # line's offset for a block line) and rotations within what the model is written for
-    worst = 0.0
-    for b in range(nb):
-        ref = -strip_f[0, SF_SQY]  # strip 0 is the keel top, its surface point -g_offset on S
-        if b > 0:
-            for j in range(strip_i.shape[0]):
-                if strip_i[j, SI_C] == b:
-                    ref = strip_f[j, SF_PY]
-        worst = max(worst, abs(x[3 * b] - ref) / opt[O_MAX_DISP])
-        worst = max(worst, abs(x[3 * b + 2]) / opt[O_MAX_ANGLE])
-    gv[o + 3] = 1.0 - worst
+N_ACC = 2
 
 
 # Dormand-Prince 5(4) coefficients (Dormand and Prince 1980) and Hairer's dense output.
@@ -141,9 +78,17 @@ def _force_arrays(nsp, ns):
 @njit(cache=True)
 def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f, opt, theta_c, ag_y, ag_z,
         dt_rec, t_end, rtol, atol, h_max, max_events, hist_x, hist_n, hist_t, ev_t, ev_kind,
-        ev_index, acc, peak_fe, peak_fn, peak_util, peak_n):
+        ev_index, acc, peak_fe, peak_fn, peak_util, peak_n, use_static, xs, reg_s, fs_s, mats,
+        bmat, gram, rows, q_vel, wind_grad, rates0):
     """Integrate from t = 0 to ``t_end`` or the first failure; returns (t_final, n_events, failure
-    code, number of history samples written, accepted steps, rejected steps).
+    code, number of history samples written, accepted steps, rejected steps, exponential steps).
+
+    With ``use_static``, a step that starts on a sample while every spring and strip is in its
+    static regime (``reg_s``, ``fs_s``) is first tried as one exponential step to the next sample
+    (:func:`_static_step`, the matrices of :func:`shipblock.section.exponential.static_steps`),
+    refused for its error, as two half steps; if an event function changes sign in one or a
+    half step's error estimate is too large, Dormand-Prince takes over from there (after an
+    error refusal, for the next ``STATIC_PAUSE`` samples).
 
     ``x``, ``reg``, ``dp``, ``fs`` are updated in place (the final state); ``dc0``, ``tc0`` hold
     the compression of every detached cap and the time it let go (start with ``dc0 = dp``). Histories are written
@@ -176,6 +121,19 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     m_delta, m_delta_dot, m_vt, m_pos, m_fe, m_fn, m_normal, m_tang = _force_arrays(nsp, ns)
     n_start = np.zeros(ns)
     stage_n = np.zeros(ns)  # the largest normal force of each strip at the step's stages
+    # exponential steps in the static regime: work arrays, and the sample before which none is
+    # tried again after an error refusal
+    nm_s = mats.shape[1]
+    wk = np.zeros((8, 3 * nm_s))
+    xm_s = np.zeros(nx)
+    fm_s = np.zeros(nx)
+    gvm_s = np.zeros(ng)
+    n_static = 0
+    static_from = 0
+    u_start = np.zeros(ns)  # friction utilisation at the step's start (-1: no normal force)
+    xm_n = np.zeros(ns)
+    xm_t = np.zeros(ns)
+    n_in = ag_y.shape[0]
     t = 0.0
     n_ev = 0
     ev_t[0] = 0.0
@@ -213,11 +171,74 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
                  delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
     for j in range(ns):
         n_start[j] = normal[j]
+        u_start[j] = abs(tang[j]) / normal[j] if normal[j] > 0.0 else -1.0
     while t < t_end and failure == 0:
         # steps end on the input samples (the input is linear between them)
         t_next = (math.floor(t / dt_rec + 1e-9) + 1.0) * dt_rec
         if t_end - t < 1e-12 * dt_rec:
             break
+        ks = int(math.floor(t / dt_rec + 0.5))
+        if (use_static and ks >= static_from and abs(t - ks * dt_rec) <= 1e-9 * dt_rec
+                and ks + 1 < n_in and t_next <= t_end + 1e-12 * dt_rec
+                and _in_static(reg, fs, reg_s, fs_s)):
+            # one step over the sample interval; refused for its error, two half steps; an
+            # event or a half step's error: Dormand-Prince from where they got to
+            level = 0
+            half = 0
+            slope_y = (ag_y[ks + 1] - ag_y[ks]) / dt_rec
+            slope_z = (ag_z[ks + 1] - ag_z[ks]) / dt_rec
+            done = False
+            while True:
+                tau = dt_rec if level == 0 else 0.5 * dt_rec
+                off = 0.5 * dt_rec * half
+                code = _static_step(t, tau, level, ag_y[ks] + slope_y * off,
+                                    ag_z[ks] + slope_z * off, slope_y, slope_z, x, k1, g0, nb,
+                                    ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, dc0,
+                                    tc0, fs, opt, theta_c, ag_y, ag_z, dt_rec, rtol, atol, xs,
+                                    mats, bmat, gram, rows, q_vel, wind_grad, rates0, wk, x1,
+                                    xm_s, k7, fm_s, g1, gvm_s,
+                                    (delta, delta_dot, vt, pos, fe, fn, normal, tang),
+                                    (m_delta, m_delta_dot, m_vt, m_pos, m_fe, m_fn, m_normal,
+                                     m_tang))
+                if code == 2 and level == 0:
+                    level = 1
+                    continue
+                if code != 0:
+                    if code == 2:
+                        static_from = ks + STATIC_PAUSE
+                    break
+                n_static += 1
+                _track(nsp, ns, m_fe, m_fn, m_normal, m_tang, peak_fe, peak_fn, peak_util,
+                       peak_n)
+                _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n)
+                # peaks inside: on the middle's work arrays (tracked already), not the end's
+                _static_inside(tau, x, xm_s, x1, k1, fm_s, k7, n_start, u_start, m_normal,
+                               m_tang, normal, tang, nb, ns, nsp, strip_f, strip_i, spring_f,
+                               reg, dp, fs, xe, (m_delta, m_delta_dot, m_vt, m_pos, m_fe, m_fn,
+                                                 xm_n, xm_t),
+                               peak_fe, peak_fn, peak_util, peak_n)
+                t = (ks + 1) * dt_rec if (level == 0 or half == 1) else t + tau
+                for m in range(nx):
+                    x[m] = x1[m]
+                    k1[m] = k7[m]
+                for q in range(ng):
+                    g0[q] = g1[q]
+                while n_hist < n_samples and n_hist * dt_rec <= t + 1e-12 * dt_rec:
+                    for m in range(nx):
+                        hist_x[n_hist, m] = x[m]
+                    for j in range(ns):
+                        hist_n[n_hist, j] = normal[j]
+                        hist_t[n_hist, j] = tang[j]
+                    n_hist += 1
+                for j in range(ns):
+                    n_start[j] = normal[j]
+                    u_start[j] = abs(tang[j]) / normal[j] if normal[j] > 0.0 else -1.0
+                if level == 0 or half == 1:
+                    done = True
+                    break
+                half = 1
+            if done:
+                continue
         h = min(h, h_max, t_next - t, t_end - t)
         if h < 1e-15 * max(1.0, t):
             failure = EV_STALL
@@ -288,7 +309,6 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             if g1[q] <= 0.0 and (g0[q] > 0.0 or (g0[q] == 0.0 and _is_gap(q, nsp, reg))):
                 a, b, ga, gb = 0.0, 1.0, g0[q], g1[q]
                 if first >= 0:
-                    acc[3] += 1.0
                     # only look before the earliest one found so far
                     dense(r, hi, xe)
                     event_values(t + hi * h, xe, nb, ns, strip_f, strip_i, spring_f, reg, dp,
@@ -306,7 +326,6 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
                     # stay strictly inside, and bisect when the secant hugs an end
                     if not (a + 0.01 * (b - a) < mid < b - 0.01 * (b - a)):
                         mid = min(max(mid, a + 0.01 * (b - a)), b - 0.01 * (b - a))
-                    acc[2] += 1.0
                     dense(r, mid, xe)
                     event_values(t + mid * h, xe, nb, ns, strip_f, strip_i, spring_f, reg, dp,
                                  dc0, tc0, fs, opt, delta, delta_dot, vt, pos, fe, fn, normal,
@@ -389,6 +408,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
                          delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
         for j in range(ns):
             n_start[j] = normal[j]
+            u_start[j] = abs(tang[j]) / normal[j] if normal[j] > 0.0 else -1.0
         # step-size controller (elementary, order 5 solution with a 4th-order error estimate;
         # Hairer's stabilised controller was tried: fewer rejections, as many evaluations)
         h = h * min(5.0, max(0.2, 0.9 * max(err, 1e-10) ** -0.2))
@@ -399,7 +419,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             acc[A_CAP_RELAX] -= 0.5 * spring_f[i, PF_K] * rem * rem
             dc0[i] = dp[i] + rem
             tc0[i] = t
-    return t, n_ev, failure, n_hist, n_acc, n_rej
+    return t, n_ev, failure, n_hist, n_acc, n_rej, n_static
 
 
 @njit(cache=True)
@@ -486,17 +506,6 @@ def _track_inside(hi, r, stage_n, nb, ns, nsp, strip_f, strip_i, spring_f, reg, 
 
 
 @njit(cache=True)
-def _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n):
-    for i in range(nsp):
-        peak_fe[i] = max(peak_fe[i], fe[i])
-        peak_fn[i] = max(peak_fn[i], fn[i])
-    for j in range(ns):
-        peak_n[j] = max(peak_n[j], normal[j])
-        if normal[j] > 0.0:
-            peak_util[j] = max(peak_util[j], abs(tang[j]) / normal[j])
-
-
-@njit(cache=True)
 def _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, delta,
                 normal, tang, acc):
     """Apply event ``q`` at time t (state x just past it); returns (event kind, index)."""
@@ -573,14 +582,10 @@ def _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, 
 
 
 @njit(cache=True, inline="always")
-def _is_gap(q, nsp, reg):
-    """Whether event function ``q`` is the gap of a spring that is not carrying."""
-    return q < 2 * nsp and q % 2 == 0 and reg[q // 2] == R_FREE
-
-
-@njit(cache=True, inline="always")
 def _strip_of(i, strip_i):
     for j in range(strip_i.shape[0]):
         if strip_i[j, SI_FIRST] <= i < strip_i[j, SI_FIRST] + strip_i[j, SI_COUNT]:
             return j
     return -1
+
+
