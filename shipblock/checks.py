@@ -34,7 +34,7 @@ import math
 import os
 import re
 import tomllib
-from collections.abc import Collection, Iterable, Mapping
+from collections.abc import Callable, Collection, Iterable, Mapping
 
 import numpy as np
 
@@ -75,6 +75,7 @@ __all__ = [
     "time_step",
     "toml_document",
     "toml_file",
+    "toml_text",
     "unit",
     "whole",
 ]
@@ -656,8 +657,17 @@ def toml_document(source: str) -> dict:
     return document
 
 
-def toml_file(path, what: str = "TOML file") -> dict:
-    """Read a TOML file with :func:`toml_document`; every failure a ParameterError naming it.
+def _parameter_error(path: str, problem: str) -> ParameterError:
+    return ParameterError(f"{path}: {problem}")
+
+
+def toml_text(path, what: str = "TOML file",
+              error: Callable[[str, str], Exception] = _parameter_error) -> str:
+    """The text of a TOML file, checked to be text; every failure an error naming the file.
+
+    The one reader of shipblock's TOML files (pipelines, catalogues, system and processing
+    chain files; :func:`toml_file` parses what it reads): each caller gets the same checks
+    and messages, in its own error type.
 
     Parameters
     ----------
@@ -665,6 +675,57 @@ def toml_file(path, what: str = "TOML file") -> dict:
         The file.
     what : str
         What the file is, for the messages (``"system file"``).
+    error : callable, optional
+        ``error(path, problem)`` makes the exception raised for the file ``path`` (a str) and
+        the ``problem`` (a message without the file name), e.g.
+        :class:`~shipblock.errors.RecordError`; by default a
+        :class:`~shipblock.errors.ParameterError` whose message is ``"<path>: <problem>"``.
+
+    Returns
+    -------
+    str
+        The file's text (not yet parsed).
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``path`` is not a path.
+    Exception
+        Made by ``error``: the file is missing or unreadable (a folder), not UTF-8 text or
+        binary (a NUL byte).
+    """
+    path = pathname(path, "path", f"a {what}")
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read()
+    except FileNotFoundError:
+        raise error(str(path), f"{what} not found (path must name a {what})") from None
+    except OSError as exc:
+        raise error(str(path), f"cannot read the {what} ({exc})") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise error(str(path), f"is not a {what}: not UTF-8 text (byte 0x{data[exc.start]:02x} at "
+                               f"offset {exc.start}); a {what} is a TOML text file") from None
+    if "\x00" in text:
+        raise error(str(path), f"is not a {what}: binary data (a NUL byte at offset "
+                               f"{text.index(chr(0))}); a {what} is a TOML text file")
+    return text
+
+
+def toml_file(path, what: str = "TOML file",
+              error: Callable[[str, str], Exception] = _parameter_error) -> dict:
+    """Read a TOML file (:func:`toml_text`) and parse it (:func:`toml_document`); every failure
+    an error naming the file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    what : str
+        What the file is, for the messages (``"system file"``).
+    error : callable, optional
+        Makes the exception, as in :func:`toml_text`.
 
     Returns
     -------
@@ -675,19 +736,14 @@ def toml_file(path, what: str = "TOML file") -> dict:
     ------
     ParameterTypeError
         If ``path`` is not a path.
-    ParameterError
-        Beginning with the file's path: unreadable (missing, a folder), not UTF-8, not TOML,
-        or nested deeper than :data:`MAX_TOML_DEPTH` levels.
+    Exception
+        Made by ``error``: as :func:`toml_text`, and the text is not TOML or is nested deeper
+        than :data:`MAX_TOML_DEPTH` levels.
     """
-    path = pathname(path, "path", f"a {what}")
+    text = toml_text(path, what, error)
     try:
-        with open(path, "rb") as fh:
-            return toml_document(fh.read().decode("utf-8"))
-    except OSError as exc:
-        raise ParameterError(f"{path}: cannot read the {what} ({exc})") from None
-    except UnicodeDecodeError:
-        raise ParameterError(f"{path}: not a text (UTF-8) TOML file") from None
+        return toml_document(text)
     except TomlNestingError as exc:
-        raise ParameterError(f"{path}: {exc.problem}") from None
+        raise error(str(path), exc.problem) from None
     except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"{path}: not valid TOML: {exc}") from None
+        raise error(str(path), f"is not valid TOML: {exc}") from None

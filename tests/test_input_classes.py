@@ -25,7 +25,7 @@ from shipblock.errors import (
 from shipblock.fragility.design import AnalysisDesign, IntensityDesign
 from shipblock.fragility.limit_states import LimitState
 from shipblock.fragility.pipeline import PipelineError, load_pipeline, rerun_case, run_pipeline
-from shipblock.fragility.schema import parse_pipeline
+from shipblock.fragility.schema import load_system, parse_pipeline
 from shipblock.fragility.store import open_results
 from shipblock.io import check_reader_keywords, reader_keywords
 from shipblock.processing import STEPS, ProcessingError
@@ -187,6 +187,38 @@ def test_every_toml_reader_names_the_file_for_deep_nesting(tmp_path):
         with pytest.raises(error) as info:
             read(deep)
         assert str(info.value).startswith(expected)
+
+
+#: A file no TOML reader can read, by what is wrong with it: (name, bytes or None for no file,
+#: what the message says).
+BAD_FILES = {
+    "missing": ("missing.toml", None, "not found"),
+    "not UTF-8": ("latin1.toml", "title = 'Ume\xe5'\n".encode("latin-1"),
+                  "not UTF-8 text (byte 0xe5 at offset 12)"),
+    "binary": ("nul.toml", b"schema_version = 1\x00\x01", "binary data (a NUL byte at offset 18)"),
+    "not TOML": ("broken.toml", b"[[record]\n", "is not valid TOML"),
+}
+
+
+@pytest.mark.parametrize("bad", BAD_FILES)
+def test_every_toml_file_reader_names_the_file_once_in_its_own_error(tmp_path, bad):
+    """Pipelines, catalogues and system files are read by one reader
+    (:func:`shipblock.checks.toml_text`): the same checks and messages, each reader's own error
+    type, the file named once at the start (a system file read for 'simulate --system' named
+    it twice, a catalogue's undecodable bytes were 'not valid TOML')."""
+    name, data, says = BAD_FILES[bad]
+    path = tmp_path / name
+    if data is not None:
+        path.write_bytes(data)
+    readers = [(load_pipeline, PipelineError), (load_catalogue, RecordError),
+               (ShipBlockSystem.from_toml, ParameterError), (load_system, PipelineError)]
+    for read, error in readers:
+        with pytest.raises(error) as info:
+            read(path)
+        message = str(info.value)
+        assert message.startswith(f"{path}: "), message
+        assert message.count(str(path)) == 1, message
+        assert says in message, message
 
 
 # -------------------------------------------------------------------------------------------

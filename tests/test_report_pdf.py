@@ -17,7 +17,7 @@ from shipblock.cli import main
 from shipblock.errors import ParameterError
 from shipblock.plot import study_caption
 from shipblock.report import pdf_pages, report_document, write_report
-from shipblock.report.document import Figure, Heading, Table
+from shipblock.report.document import Figure, Heading, Paragraph, Table
 from shipblock.risk import run_risk
 
 from .test_report_html import PGA_CURVES, demo  # noqa: F401 - the module's study fixture
@@ -148,3 +148,52 @@ def test_format_from_the_suffix_the_flag_and_refused_by_name(demo, tmp_path, mon
     a, b = (np.array(re.findall(rb"/Type /Page\b", p.read_bytes())).size
             for p in (tmp_path / "r.pdf", beside))
     assert a == b
+
+
+# -- a heading is kept with what follows it --------------------------------------------------
+
+def _filler(n):
+    """A paragraph of ``n`` lines: moves what follows it down the first page, line by line."""
+    return Paragraph(tuple(f"filler line {i}" for i in range(n)))
+
+
+def _plain_figure():
+    fig = plt.figure(figsize=(7.0, 4.5))
+    fig.add_subplot().plot([0.0, 1.0], [0.0, 1.0])
+    return fig
+
+
+def _page_of(pages, text):
+    (page,) = [i for i, texts in enumerate(pages) if text in texts]
+    return page
+
+
+@pytest.mark.parametrize("filler", range(40, 80, 3))
+def test_a_heading_starts_the_page_of_its_table_or_figure(filler):
+    """From every height of the text above, a section's heading (and its one-line
+    introduction) shares its page with the first row of its table and with its figure: a
+    heading was left alone at a page's foot when its table (short, kept whole) or its figure
+    did not fit below it but 1.4 in did."""
+    rows = tuple((f"cell {i}", f"{i}") for i in range(14))  # 2.1 in: short, kept on one page
+    blocks = [Heading("Report", 1), _filler(filler),
+              Heading("A table", 2), Paragraph(("The rows, one per record.",)),
+              Table(("name", "value"), rows),
+              _filler(filler // 2),
+              Heading("A figure", 3), Figure(_plain_figure, "a line"),
+              Heading("The end", 2), Paragraph(("Last words.",))]
+    pages = _page_texts(blocks, "t.nc")
+    for heading, first in (("A table", "cell 0"), ("A figure", "Figure 1: a line."),
+                           ("The end", "Last words.")):
+        assert _page_of(pages, heading) == _page_of(pages, first), (heading, pages)
+    assert _page_of(pages, "The rows, one per record.") == _page_of(pages, "A table")
+    assert len(pages) <= 4  # nothing moved more than it had to
+
+
+def test_a_heading_over_a_page_filling_figure_stays_where_it_was():
+    """A figure as tall as a page cannot share one with its heading: the heading is not moved
+    to a page of its own."""
+    tall = Figure(lambda: plt.figure(figsize=(7.0, 12.0)), "a tall one")
+    blocks = [Heading("Report", 1), _filler(20), Heading("Tall", 2), tall]
+    pages = _page_texts(blocks, "t.nc")
+    assert len(pages) == 2
+    assert _page_of(pages, "Tall") == 0 and _page_of(pages, "Figure 1: a tall one.") == 1

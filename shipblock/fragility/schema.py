@@ -240,10 +240,7 @@ def load_system(path) -> tuple[Model, object]:
     (``shipblock simulate --system FILE``). Raises :class:`PipelineError` naming the file and
     the key (``system.<key>``): unreadable, no ``[system]`` table, an invalid key or system."""
     source = str(checks.pathname(path, "path", "a system TOML file"))
-    try:
-        table = checks.toml_file(source, "system file").get("system")
-    except ShipblockError as exc:
-        raise PipelineError("", str(exc), source) from None
+    table = checks.toml_file(source, "system file", error=_file_error).get("system")
     if not isinstance(table, Mapping):
         raise PipelineError("system", "missing: the file needs a [system] table", source)
     model = _model(table, source)
@@ -275,21 +272,14 @@ def load_pipeline(path) -> Pipeline:
         raise ParameterTypeError(f"path must be the pipeline file (a str or os.PathLike), got "
                                  f"{type(path).__name__} {path!r}")
     path = Path(path)
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise PipelineError("", f"cannot read the pipeline file ({exc})", str(path)) from exc
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise PipelineError("", f"is not a pipeline file: not UTF-8 text (byte 0x{data[exc.start]:02x} "
-                                f"at offset {exc.start}); a pipeline is a TOML text file",
-                            str(path)) from None
-    if "\x00" in text:
-        raise PipelineError("", f"is not a pipeline file: binary data (a NUL byte at offset "
-                                f"{text.index(chr(0))}); a pipeline is a TOML text file",
-                            str(path))
+    text = checks.toml_text(path, "pipeline file", error=_file_error)
     return parse_pipeline(text, base=path.resolve().parent, source=str(path))
+
+
+def _file_error(path: str, problem: str) -> PipelineError:
+    """The error of a pipeline or system file that cannot be read as TOML (for
+    :func:`shipblock.checks.toml_file`)."""
+    return PipelineError("", problem, path)
 
 
 def parse_pipeline(text: str, base=".", source: str = "<pipeline>") -> Pipeline:

@@ -10,14 +10,13 @@ codes to the components H1, H2 and V. Paths are relative to the catalogue file.
 from __future__ import annotations
 
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from shipblock import checks
-from shipblock.errors import ParameterError, ParameterTypeError, RecordError, TomlNestingError
+from shipblock.errors import ParameterError, ParameterTypeError, RecordError
 from shipblock.records.arguments import check_read_arguments
 from shipblock.records.folders import MotionSet
 from shipblock.records.motion import COMPONENTS, GroundMotion
@@ -270,18 +269,7 @@ def load_catalogue(path=None) -> dict[str, CatalogueEntry]:
     if catalogue.is_dir():
         raise RecordError(catalogue, "is a folder, not a file (path must name a catalogue TOML"
                                      " file; 'shipblock catalogue FOLDER' writes one)")
-    try:
-        with open(catalogue, "rb") as fh:
-            document = checks.toml_document(fh.read().decode("utf-8"))
-    except FileNotFoundError:
-        raise RecordError(catalogue, "catalogue file not found (path must name a catalogue TOML"
-                                     " file)") from None
-    except OSError as exc:
-        raise RecordError(catalogue, f"cannot be read: {exc}") from exc
-    except TomlNestingError as exc:
-        raise RecordError(catalogue, exc.problem) from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise RecordError(catalogue, f"is not valid TOML: {exc}") from exc
+    document = checks.toml_file(catalogue, "catalogue file", error=RecordError)
     version = document.get("schema_version", SCHEMA_VERSION)
     if version != SCHEMA_VERSION:
         raise RecordError(catalogue, f"schema_version {version} is not {SCHEMA_VERSION}")

@@ -8,8 +8,10 @@ so a reader can search and copy it); tables are set in a monospaced font, their 
 as their longest cell within the page, wrapped when the page is too narrow, and split across
 pages with the header repeated; each figure is drawn once and placed as an image of
 :data:`PDF_DPI` dots per inch, scaled to the page's width, with its description under it. A
-heading is never left alone at the foot of a page. Every page has the report's title at its top
-and ``page i of n`` at its foot.
+heading is kept with what follows it (:func:`_keep_with_next`): with its short introduction
+and at least the first rows of its table, the first lines of its text or its whole figure;
+when these do not fit below it, the heading starts the next page. Every page has the report's
+title at its top and ``page i of n`` at its foot.
 """
 
 from __future__ import annotations
@@ -49,6 +51,10 @@ _LEADING = 1.3  # line height / font size
 
 #: A heading needs this much space below it on its page, or it goes to the next [in].
 _KEEP_WITH_NEXT = 1.4
+
+#: A paragraph of at most this many lines between a heading and a table, text or figure
+#: introduces it, and is kept with both [lines].
+_INTRO_LINES = 3
 
 #: A column is narrowed below its longest word only after every other column [characters].
 _LONG_WORD = 24
@@ -104,6 +110,23 @@ class _Layout:
         """A new page unless ``height`` fits below the cursor (or the page is empty)."""
         if height > self.room and self.pages[-1]:
             self.new_page()
+
+    def mark(self) -> tuple[int, int, float]:
+        """Where the layout stands: pages, operations on the last page, cursor."""
+        return len(self.pages), len(self.pages[-1]), self.y
+
+    def undo(self, mark: tuple[int, int, float]) -> None:
+        """Back to ``mark``: what was laid out since is taken away."""
+        pages, ops, self.y = mark
+        del self.pages[pages:]
+        del self.pages[-1][ops:]
+
+    def page_after(self, mark: tuple[int, int, float]) -> int | None:
+        """The page of the first operation laid out since ``mark`` (None: none)."""
+        pages, ops, _ = mark
+        if len(self.pages[pages - 1]) > ops:
+            return pages - 1
+        return next((i for i in range(pages, len(self.pages)) if self.pages[i]), None)
 
     def add(self, op: _Op, height: float) -> None:
         op.y = self.y
@@ -236,8 +259,7 @@ def _rendered(block: Figure) -> np.ndarray:
     return (plt.imread(buffer, format="png")[..., :3] * 255).round().astype(np.uint8)
 
 
-def _figure(layout: _Layout, block: Figure, number: int) -> None:
-    image = _rendered(block)
+def _figure(layout: _Layout, block: Figure, number: int, image: np.ndarray) -> None:
     height_px, width_px = image.shape[:2]
     caption = _wrap(f"Figure {number}: {block.alt}.", _columns(_SIZES["small"]))
     caption_height = len(caption) * _line_height(_SIZES["small"])
@@ -257,10 +279,35 @@ def _links(layout: _Layout, block: Links) -> None:
                       font="monospace")
 
 
+def _is_intro(block) -> bool:
+    """Whether ``block`` is a short paragraph, an introduction to what follows it."""
+    return isinstance(block, Paragraph) and not block.small and sum(
+        len(_wrap(line, _columns(_SIZES["body"]))) for line in block.lines) <= _INTRO_LINES
+
+
+def _keep_with_next(blocks, start: int) -> int:
+    """The end (exclusive) of the group that starts with the heading ``blocks[start]``: the
+    headings in a row, the short paragraphs introducing what follows them, and the first
+    block that is neither (the content kept with the headings)."""
+    end = start
+    while end < len(blocks) and isinstance(blocks[end], Heading):
+        end += 1
+    while (end + 1 < len(blocks) and _is_intro(blocks[end])
+           and not isinstance(blocks[end + 1], Heading)):
+        end += 1
+    return min(end + 1, len(blocks))
+
+
 def _layout(blocks) -> _Layout:
+    """The blocks on pages. A heading's group (:func:`_keep_with_next`) is laid out, and if its
+    content begins on a later page than its last heading, laid out again from the top of the
+    next page, unless the content would not begin on the heading's page there either (a
+    figure as tall as a page), where it stays as it was."""
     layout = _Layout()
-    figures = 0
-    for block in blocks:
+    numbers = {id(b): n for n, b in enumerate((b for b in blocks if isinstance(b, Figure)), 1)}
+    images = {}  # each figure drawn once, however often its group is laid out
+
+    def lay(block):
         if isinstance(block, Heading):
             _heading(layout, block)
         elif isinstance(block, Paragraph):
@@ -270,12 +317,46 @@ def _layout(blocks) -> _Layout:
         elif isinstance(block, Preformatted):
             _preformatted(layout, block)
         elif isinstance(block, Figure):
-            figures += 1
-            _figure(layout, block, figures)
+            if id(block) not in images:
+                images[id(block)] = _rendered(block)
+            _figure(layout, block, numbers[id(block)], images[id(block)])
         elif isinstance(block, Links):
             _links(layout, block)
         else:
             raise TypeError(f"not a report block: {block!r}")
+
+    def lay_group(group) -> bool:
+        """Lay ``group`` out; whether its content begins on its last heading's page (so its
+        introductions, between them, are there too)."""
+        headings = [b for b in group if isinstance(b, Heading)]
+        for block in headings:
+            lay(block)
+        heading_page = len(layout.pages) - 1
+        rest = group[len(headings):]
+        for block in rest[:-1]:  # the introductions
+            lay(block)
+        if not rest:  # the document ends with headings
+            return True
+        before_content = layout.mark()
+        lay(rest[-1])
+        return layout.page_after(before_content) in (None, heading_page)
+
+    i = 0
+    while i < len(blocks):
+        if not isinstance(blocks[i], Heading):
+            lay(blocks[i])
+            i += 1
+            continue
+        end = _keep_with_next(blocks, i)
+        group = blocks[i:end]
+        start = layout.mark()
+        if not lay_group(group) and start[1] > 0:  # not already at a page's top
+            layout.undo(start)
+            layout.new_page()
+            if not lay_group(group):  # no better on a page of its own: as it was
+                layout.undo(start)
+                lay_group(group)
+        i = end
     return layout
 
 
