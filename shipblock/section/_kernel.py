@@ -150,11 +150,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
                    delta_dot, vt, fe, fn, normal, tang)
     n_samples = hist_x.shape[0]
-    for m in range(nx):
-        hist_x[0, m] = x[m]
-    for j in range(ns):
-        hist_n[0, j] = normal[j]
-        hist_t[0, j] = tang[j]
+    _sample(0, x, normal, tang, hist_x, hist_n, hist_t)
     n_hist = 1
     _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n)
     rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
@@ -224,11 +220,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
                 for q in range(ng):
                     g0[q] = g1[q]
                 while n_hist < n_samples and n_hist * dt_rec <= t + 1e-12 * dt_rec:
-                    for m in range(nx):
-                        hist_x[n_hist, m] = x[m]
-                    for j in range(ns):
-                        hist_n[n_hist, j] = normal[j]
-                        hist_t[n_hist, j] = tang[j]
+                    _sample(n_hist, x, normal, tang, hist_x, hist_n, hist_t)
                     n_hist += 1
                 for j in range(ns):
                     n_start[j] = normal[j]
@@ -356,11 +348,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             kinematics(xe, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
             contact_forces(xe, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp,
                            fs, delta, delta_dot, vt, fe, fn, normal, tang)
-            for m in range(nx):
-                hist_x[n_hist, m] = xe[m]
-            for j in range(ns):
-                hist_n[n_hist, j] = normal[j]
-                hist_t[n_hist, j] = tang[j]
+            _sample(n_hist, xe, normal, tang, hist_x, hist_n, hist_t)
             n_hist += 1
         t = t_new
         for m in range(nx):
@@ -420,6 +408,16 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             dc0[i] = dp[i] + rem
             tc0[i] = t
     return t, n_ev, failure, n_hist, n_acc, n_rej, n_static
+
+
+@njit(cache=True, inline="always")
+def _sample(k, x, normal, tang, hist_x, hist_n, hist_t):
+    """History sample ``k``: the state and the strips' normal and tangential forces."""
+    for m in range(x.shape[0]):
+        hist_x[k, m] = x[m]
+    for j in range(normal.shape[0]):
+        hist_n[k, j] = normal[j]
+        hist_t[k, j] = tang[j]
 
 
 @njit(cache=True)

@@ -118,6 +118,18 @@ def _mv(a, v, out, c0):
         out[i] = s
 
 
+@njit(cache=True, inline="always")
+def _remainder_slope(x1, f1, xs, a_m, g0, h, tmp, ay, out):
+    """``out = (g(x1) - g0) / h``, the slope of the remainder ``g = f - A (x - x_s)`` from its
+    value ``g0`` at the step's start to its value at ``x1`` (rates ``f1``)."""
+    nm = a_m.shape[0]
+    for m in range(nm):
+        tmp[m] = x1[m] - xs[m]
+    _mv(a_m, tmp, ay, 0)
+    for m in range(nm):
+        out[m] = (f1[m] - ay[m] - g0[m]) / h
+
+
 @njit(cache=True)
 def _static_step(t, h, level, ay0, az0, slope_y, slope_z, x, f0, gv0, nb, ns, mass, inertia,
                  strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, theta_c, ag_y, ag_z,
@@ -162,22 +174,14 @@ def _static_step(t, h, level, ay0, az0, slope_y, slope_z, x, f0, gv0, nb, ns, ma
     rhs(t + h, x1, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y,
         ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, f1)
     # corrector: the remainder linear over the step, through its value at the predicted end
-    for m in range(nm):
-        tb[m] = x1[m] - xs[m]
-    _mv(a_m, tb, ta, 0)
-    for m in range(nm):
-        c[m] = (f1[m] - ta[m] - g0[m]) / h
+    _remainder_slope(x1, f1, xs, a_m, g0, h, tb, ta, c)
     _mv(pc_m, c, tb, nv)
     for m in range(nm):
         x1[m] = xs[m] + base[m] + tb[m]
     rhs(t + h, x1, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y,
         ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, f1)
     # error estimate: a second corrector from the rates at the corrected end
-    for m in range(nm):
-        tb[m] = x1[m] - xs[m]
-    _mv(a_m, tb, ta, 0)
-    for m in range(nm):
-        w[m] = (f1[m] - ta[m] - g0[m]) / h
+    _remainder_slope(x1, f1, xs, a_m, g0, h, tb, ta, w)
     _mv(pc_m, w, ta, nv)
     err = 0.0
     for m in range(nm):
