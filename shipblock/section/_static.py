@@ -39,17 +39,19 @@ def _static_dense(theta, h, x0, xm, x1, f0, fm, f1, out):
     """State at ``t + theta h`` of an exponential step: the quintic through the ends' and the
     middle's states and rates (the exact trajectory's transients have decayed by then to the
     step's accuracy, or are what the rates carry)."""
-    c = np.zeros(6)
-    for i in range(6):
-        s = 0.0
-        p = 1.0
-        for kk in range(6):
-            s += _HERMITE[kk, i] * p
-            p *= theta
-        c[i] = s
+    c0 = c1 = c2 = c3 = c4 = c5 = 0.0
+    p = 1.0
+    for kk in range(6):  # the basis at theta, summed over theta's powers (no array per call)
+        c0 += _HERMITE[kk, 0] * p
+        c1 += _HERMITE[kk, 1] * p
+        c2 += _HERMITE[kk, 2] * p
+        c3 += _HERMITE[kk, 3] * p
+        c4 += _HERMITE[kk, 4] * p
+        c5 += _HERMITE[kk, 5] * p
+        p *= theta
     for m in range(out.shape[0]):
-        out[m] = (c[0] * x0[m] + c[1] * xm[m] + c[2] * x1[m]
-                  + h * (c[3] * f0[m] + c[4] * fm[m] + c[5] * f1[m]))
+        out[m] = (c0 * x0[m] + c1 * xm[m] + c2 * x1[m]
+                  + h * (c3 * f0[m] + c4 * fm[m] + c5 * f1[m]))
 
 
 @njit(cache=True)
