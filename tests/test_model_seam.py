@@ -17,7 +17,11 @@ one limit state, time histories, a rerun) is run through it. The checks are clos
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
 from dataclasses import asdict, dataclass, replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -26,7 +30,17 @@ from scipy import signal
 
 from shipblock.fragility.keys import key_table
 from shipblock.fragility.pipeline import PipelineError, load_pipeline, rerun_case, run_pipeline
-from shipblock.models import EDPInfo, Field, FieldError, Model, register_model, unregister_model
+from shipblock.errors import ParameterError
+from shipblock.models import (
+    EDPInfo,
+    Field,
+    FieldError,
+    Model,
+    get_model,
+    model_names,
+    register_model,
+    unregister_model,
+)
 from shipblock.units import STANDARD_GRAVITY as G
 
 from .test_batch import make_catalogue
@@ -256,3 +270,82 @@ def test_the_key_table_lists_the_models_keys(toy):
     rigid = key_table()
     assert "``system.ship_mass``" in rigid and "``solver.rtol``" in rigid
     assert "``system.period``" not in rigid
+
+
+# -- models registered by their path, imported when first asked for ---------------------------
+
+LAZY_MODULE = """
+from tests.test_model_seam import OscillatorModel
+
+
+class LazyOscillator(OscillatorModel):
+    name = "lazy_toy"
+"""
+
+
+@pytest.fixture
+def lazy_module(tmp_path, monkeypatch):
+    """A module ``lazy_toy_model`` on the path, not imported, with a model ``lazy_toy``."""
+    (tmp_path / "lazy_toy_model.py").write_text(LAZY_MODULE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    yield "lazy_toy_model"
+    unregister_model("lazy_toy")
+    unregister_model("misnamed")
+    sys.modules.pop("lazy_toy_model", None)
+
+
+def test_a_model_registered_by_its_path_is_imported_when_first_asked_for(lazy_module):
+    register_model("lazy_toy_model:LazyOscillator", name="lazy_toy")
+    assert "lazy_toy" in model_names()
+    assert lazy_module not in sys.modules
+    model = get_model("lazy_toy")
+    assert lazy_module in sys.modules
+    assert isinstance(model, OscillatorModel) and model.name == "lazy_toy"
+    assert get_model("lazy_toy") is model  # made once
+    # the loaded model is the registered one: re-registering its instance is no clash
+    assert register_model(model) is model
+
+
+def test_a_path_registration_is_checked(lazy_module):
+    with pytest.raises(ParameterError, match="'package.module:Class'"):
+        register_model("lazy_toy_model.LazyOscillator", name="lazy_toy")
+    with pytest.raises(ParameterError, match="needs a name="):
+        register_model("lazy_toy_model:LazyOscillator")
+    with pytest.raises(ParameterError, match="already registered"):
+        register_model("lazy_toy_model:LazyOscillator", name="section")
+    with pytest.raises(ParameterError, match="name= is for a model registered by its path"):
+        register_model(OscillatorModel(), name="toy")
+    register_model("lazy_toy_model:LazyOscillator", name="misnamed")
+    with pytest.raises(ParameterError, match="'misnamed'.*names itself 'lazy_toy'"):
+        get_model("misnamed")
+
+
+# a fresh process (this one has imported the section package already): a rigid study's pipeline
+# is loaded with the command line imported; then the section model is asked for
+_RIGID_STUDY_CHILD = """
+import json, sys
+import shipblock.cli
+from shipblock.fragility.pipeline import load_pipeline
+from shipblock.models import get_model, model_names
+
+study = load_pipeline(sys.argv[1])
+loaded = sorted(m for m in sys.modules if m.startswith(("shipblock.section", "shipblock.models.section")))
+section = get_model("section")
+print(json.dumps({"model": study.model.name, "names": list(model_names()), "loaded": loaded,
+                  "kernel_after": "shipblock.section._kernel" in sys.modules,
+                  "section_class": type(section).__module__ + "." + type(section).__name__}))
+"""
+
+
+def test_a_rigid_study_does_not_import_the_section_model():
+    root = Path(__file__).resolve().parents[1]
+    proc = subprocess.run([sys.executable, "-c", _RIGID_STUDY_CHILD,
+                           str(root / "pipelines" / "demo.toml")],
+                          capture_output=True, text=True, cwd=root, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    out = json.loads(proc.stdout.splitlines()[-1])
+    assert out["model"] == "rigid"
+    assert "section" in out["names"]
+    assert out["loaded"] == []
+    assert out["kernel_after"]
+    assert out["section_class"] == "shipblock.models.section.SectionModel"

@@ -24,12 +24,17 @@ pipelines, the command line) never touches a model's equations. It talks to a :c
 Models are found by name (:func:`get_model`); a pipeline chooses one with
 ``[system] model = "<name>"`` (default ``"rigid"``, :class:`shipblock.models.rigid.RigidModel`).
 A new model is a subclass of :class:`Model` registered with :func:`register_model`; no study
-code changes (``docs/contributing.rst``).
+code changes (``docs/contributing.rst``). A model whose module is heavy to import (a compiled
+kernel, its numba caches) may be registered by the path of its class instead,
+``"package.module:Class"``: the module is imported, and the model made, when the model is
+first asked for by name, so that a study of another model never pays for it.
 """
 
 from __future__ import annotations
 
+import importlib
 import math
+import threading
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -410,30 +415,60 @@ class Model(ABC):
 # registry
 # ------------------------------------------------------------------------------------------
 
-_REGISTRY: dict[str, Model] = {}
+# A name -> its model, or the "module:Class" path of a model not loaded yet (get_model loads it
+# once; the lock keeps two threads of a Dask worker from making two instances of it).
+_REGISTRY: dict[str, Model | str] = {}
+_LOADING = threading.Lock()
 
 
-def register_model(model: Model, *, replace: bool = False) -> Model:
+def register_model(model: Model | str, *, name: str | None = None, replace: bool = False
+                   ) -> Model | str:
     """Make ``model`` available by its name (to pipelines: ``[system] model = "<name>"``).
 
     Parameters
     ----------
-    model : Model
-        An instance.
+    model : Model or str
+        An instance, or the path ``"package.module:Class"`` of a :class:`Model` subclass (or
+        of an instance) loaded when the model is first asked for (:func:`get_model`): its
+        module is imported only then, so that a model that is heavy to import (a compiled
+        kernel) costs nothing to the studies of other models.
+    name : str, optional
+        The name a path is registered under (required with a path; the loaded model's
+        :attr:`Model.name` must equal it). Not given with an instance, which names itself.
     replace : bool
         Replace a model registered under the same name (else that is an error).
 
     Returns
     -------
-    Model
+    Model or str
         ``model``.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``model`` is neither a :class:`Model` nor a string.
+    ParameterError
+        If the name is taken, a path is not ``"module:Class"`` or comes without ``name``, or
+        ``name`` is given with an instance.
     """
-    if not isinstance(model, Model):
-        raise ParameterTypeError(f"model must be a shipblock.models.Model, got "
-                                 f"{type(model).__name__}")
-    if model.name in _REGISTRY and not replace and _REGISTRY[model.name] is not model:
-        raise ParameterError(f"a model named {model.name!r} is already registered")
-    _REGISTRY[model.name] = model
+    if isinstance(model, str):
+        module, _, attribute = model.partition(":")
+        if not module or not attribute:
+            raise ParameterError(f"a model's path must be 'package.module:Class', got {model!r}")
+        if not isinstance(name, str) or not name:
+            raise ParameterError(f"a model registered by its path ({model!r}) needs a name=")
+        key = name
+    elif isinstance(model, Model):
+        if name is not None:
+            raise ParameterError(f"name= is for a model registered by its path; {model!r} is "
+                                 f"named {model.name!r} by its class")
+        key = model.name
+    else:
+        raise ParameterTypeError(f"model must be a shipblock.models.Model or the path "
+                                 f"'package.module:Class' of one, got {type(model).__name__}")
+    if key in _REGISTRY and not replace and _REGISTRY[key] is not model:
+        raise ParameterError(f"a model named {key!r} is already registered")
+    _REGISTRY[key] = model
     return model
 
 
@@ -443,12 +478,27 @@ def unregister_model(name: str) -> None:
 
 
 def model_names() -> tuple[str, ...]:
-    """Names of the registered models, in registration order."""
+    """Names of the registered models, in registration order (those registered by a path
+    included, loaded or not)."""
     return tuple(_REGISTRY)
 
 
+def _load(name: str, path: str) -> Model:
+    """The model at ``path`` (``"module:Class"``, registered as ``name``), made once."""
+    module, _, attribute = path.partition(":")
+    target = getattr(importlib.import_module(module), attribute)
+    model = target() if isinstance(target, type) else target
+    if not isinstance(model, Model):
+        raise ParameterTypeError(f"model {name!r} ({path}) is not a shipblock.models.Model: "
+                                 f"{type(model).__name__}")
+    if model.name != name:
+        raise ParameterError(f"model {name!r} ({path}) names itself {model.name!r}")
+    return model
+
+
 def get_model(name: str) -> Model:
-    """The registered model called ``name``.
+    """The registered model called ``name`` (one registered by its path is loaded on the first
+    call, and the same instance returned afterwards).
 
     Raises
     ------
@@ -456,8 +506,14 @@ def get_model(name: str) -> Model:
         With ``field = "model"``, naming the registered models.
     """
     try:
-        return _REGISTRY[name]
+        model = _REGISTRY[name]
     except (KeyError, TypeError):
         raise FieldError("model", f"unknown model {name!r}; registered models: "
                                   f"{', '.join(map(repr, _REGISTRY))}") from None
-
+    if isinstance(model, Model):
+        return model
+    with _LOADING:
+        model = _REGISTRY[name]
+        if isinstance(model, str):
+            model = _REGISTRY[name] = _load(name, model)
+    return model
