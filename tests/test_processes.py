@@ -9,10 +9,19 @@ Ctrl-C is) and checks that the captured pipes close (no process holds them), tha
 run's processes is left, and, for SIGTERM and SIGINT, the message and exit status and that no
 traceback was printed. The SIGKILL case runs twice: with Linux's parent-death signal and with
 the watchdog thread used where that does not exist.
+
+The run is started as a shell starts a command in the foreground, with Ctrl-C's default
+action, whatever this test process has: a process inherits an ignored SIGINT through fork and
+exec, and Python keeps it ignored. pytest run as a background job of a shell without job
+control (``.ci/run > log &``) ignores SIGINT, and a run it started without that reset ignored
+the Ctrl-C and was still alive 30 s later, as in the full CI runs of session 19. To make that
+condition part of every run of the test, the run is always started while this process ignores
+SIGINT (:func:`_sigint_ignored`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -28,7 +37,10 @@ psutil = pytest.importorskip("psutil")
 
 _RUN_HELD_IN_BOOTSTRAP = textwrap.dedent(
     """
-    import os, sys, time
+    import os, signal, sys, time
+    # Ctrl-C's default action, as a shell gives a foreground command: the SIGINT that this
+    # process inherits from the test's process may be ignored (see the module's docstring)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     from pathlib import Path
     from shipblock import processes
     from shipblock.fragility import workers
@@ -61,6 +73,17 @@ def _alive(pid: int) -> bool:
         return False
 
 
+@contextlib.contextmanager
+def _sigint_ignored():
+    """Ignore SIGINT in this process within the block, as a background job of a
+    shell without job control does from its start; the previous handler is restored."""
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 @pytest.fixture(scope="module")
 def pipeline(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("held")
@@ -70,25 +93,17 @@ def pipeline(tmp_path_factory):
     return path
 
 
-#: Ctrl-C timed out (the run still alive 30 s after SIGINT) in each of the three full CI runs
-#: of session 19, with and without that session's lazy model import, and passes alone, with its
-#: module and with the tests before it that the session changed: not understood yet (closing
-#: note of session 19); the other ways to end a run still must pass.
-_CTRL_C_IN_CI = pytest.mark.xfail(reason="Ctrl-C in the bootstrap timed out in full CI runs "
-                                         "only (session 19): under investigation", strict=False)
-
-
 @pytest.mark.parametrize(("how", "death"), [("SIGKILL", "prctl"), ("SIGKILL", "watchdog"),
-                                            ("SIGTERM", "prctl"),
-                                            pytest.param("SIGINT", "prctl", marks=_CTRL_C_IN_CI)])
+                                            ("SIGTERM", "prctl"), ("SIGINT", "prctl")])
 def test_no_process_outlives_a_run_ended_in_the_bootstrap(pipeline, tmp_path, how, death):
     marks = tmp_path / "marks"
     marks.mkdir()
     out = tmp_path / "result.nc"
-    proc = subprocess.Popen([sys.executable, "-c", _RUN_HELD_IN_BOOTSTRAP, str(pipeline),
-                             str(out), str(marks), death],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            start_new_session=True)
+    with _sigint_ignored():  # the run must not depend on how this process was started
+        proc = subprocess.Popen([sys.executable, "-c", _RUN_HELD_IN_BOOTSTRAP, str(pipeline),
+                                 str(out), str(marks), death],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                start_new_session=True)
     workers = []
     try:
         deadline = time.monotonic() + 120
