@@ -9,7 +9,8 @@ import scipy.linalg
 
 from shipblock.bench.section import navy_dock, record
 from shipblock.errors import ParameterTypeError
-from shipblock.section.exponential import static_steps
+from shipblock.section import simulate as section_simulate
+from shipblock.section.exponential import settled_steps, static_steps
 from shipblock.section.model import assemble, static_state
 from shipblock.section.simulate import simulate_section, simulate_section_batch
 
@@ -121,6 +122,49 @@ def test_a_run_with_events_hands_over_to_dormand_prince_and_back(navy):
         want = ref.summary[key]
         if isinstance(want, float) and np.isfinite(want) and "residual" not in key:
             assert res.summary[key] == pytest.approx(want, rel=1e-3, abs=1e-9), key
+
+
+def test_settled_steps_at_the_static_state_are_the_static_steps(navy):
+    """The matrices for a settled regime, made at the static state in its regime, are the static
+    regime's (the same linearisation point: the static state is at rest)."""
+    _, asm, init, steps = navy
+    again = settled_steps(asm, init.x, init.regime, init.friction, np.zeros(asm.spring_f.shape[0]),
+                          0.005)
+    for name in ("x_s", "mats", "b", "gram", "rows", "q_vel", "wind_grad", "rates0"):
+        assert np.array_equal(getattr(again, name), getattr(steps, name)), name
+    moving = init.x.copy()
+    moving[3 * asm.n_bodies:6 * asm.n_bodies] = 0.1  # velocities: not part of the point
+    assert np.array_equal(settled_steps(asm, moving, init.regime, init.friction,
+                                        np.zeros(asm.spring_f.shape[0]), 0.005).mats, steps.mats)
+
+
+def test_a_run_settled_after_strong_motion_goes_on_in_exponential_steps(navy, monkeypatch):
+    """0.3 g over 20 s: the last event at 18.6 s leaves caps open (not the static regime); one
+    second later the run stops, makes the matrices of that regime and goes on in exponential
+    steps. Up to the stop the run is bitwise the one without; after it, its histories, energy
+    terms and demand parameters agree with Dormand-Prince's from the same state."""
+    dock = navy[0]
+    h, v, dt = record(duration=20.0, pga=0.3)
+    res = simulate_section(dock, h, v, dt)
+    monkeypatch.setattr(section_simulate, "SETTLED_REGIMES", 0)
+    ref = simulate_section(dock, h, v, dt)
+    assert res.stats["settled_regimes"] == 1 and ref.stats["settled_regimes"] == 0
+    assert res.stats["events"] == ref.stats["events"] > 100
+    last = res.events[-1].time
+    differ = np.flatnonzero(np.any(res.ship != ref.ship, axis=1))
+    assert differ.size and differ[0] * dt >= last + section_simulate.SETTLE_SECONDS - 1e-9
+    # every sample after the stop in one exponential step
+    tail = h.size - differ[0]
+    assert res.stats["exponential_steps"] - ref.stats["exponential_steps"] >= tail - 1
+    for got, want in [(res.ship, ref.ship)] + [(res.lines[k], ref.lines[k]) for k in ref.lines]:
+        err = np.abs(got - want).max(axis=0) / np.abs(want).max(axis=0)
+        assert np.all(err < 1e-5), err
+    assert abs(res.energy["residual"]) < 1e-6
+    assert res.energy["damping"] == pytest.approx(ref.energy["damping"], rel=1e-6)
+    for key in ref.summary:
+        want = ref.summary[key]
+        if isinstance(want, float) and np.isfinite(want):
+            assert res.summary[key] == pytest.approx(want, rel=1e-4, abs=1e-9), key
 
 
 def test_exponential_steps_can_be_turned_off_and_are_checked(navy):

@@ -221,7 +221,9 @@ def run_case(seed: int, case: int, compare: bool = True) -> dict:
         rec.update(outcome="exception", error=traceback.format_exc(limit=3))
         return rec
     rec.update(outcome="ran", failure=res.failure, failure_time=res.failure_time,
-               cpu=time.process_time() - t0, steps=res.stats["accepted_steps"] + res.stats["exponential_steps"],
+               cpu=time.process_time() - t0,
+               steps=res.stats["accepted_steps"] + res.stats["exponential_steps"],
+               settled_regimes=res.stats["settled_regimes"],
                **_checks(dock, res))
     if compare:
         try:

@@ -30,13 +30,17 @@ from shipblock.section._forces import (  # the layout and laws, also for K.<name
     SF_SQY, SF_SQZ, SI_C, SI_COUNT, SI_FIRST, SI_S, cap_surface, contact_forces, kinematics,
     regime_sums, rhs, stage_rhs)
 from shipblock.section._events import BIG, _event_values_of, _is_gap, _track, event_values
-from shipblock.section._static import STATIC_PAUSE, _in_static, _static_inside, _static_step
+from shipblock.section._static import (STATIC_PAUSE, _in_static, _static_inside, _static_step,
+                                       _vertex)
 
 # --- event kinds (codes in the event log) -------------------------------------------------
 EV_START, EV_CLOSE, EV_DETACH, EV_CRUSH, EV_UNLOAD, EV_SLIP, EV_STICK = 0, 1, 2, 3, 4, 5, 6
 EV_STRIP_OPEN, EV_STRIP_CLOSE = 7, 8
 EV_OVERTURN, EV_SLID_OFF, EV_TIP, EV_SEPARATION, EV_INVALID, EV_STALL = 10, 11, 12, 13, 14, 15
 EV_END = 20
+#: what :func:`run` returns as its failure code when it stops, not failed, to let the caller make
+#: exponential steps for the regime the dock has settled in (``settle_after``)
+STOP_SETTLED = 21
 
 # --- running totals (acc) ------------------------------------------------------------------------
 A_FRIC_EVENT, A_CAP_RELAX = 0, 1
@@ -79,9 +83,11 @@ def _force_arrays(nsp, ns):
 def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f, opt, theta_c, ag_y, ag_z,
         dt_rec, t_end, rtol, atol, h_max, max_events, hist_x, hist_n, hist_t, ev_t, ev_kind,
         ev_index, acc, peak_fe, peak_fn, peak_util, peak_n, use_static, xs, reg_s, fs_s, mats,
-        bmat, gram, rows, q_vel, wind_grad, rates0):
-    """Integrate from t = 0 to ``t_end`` or the first failure; returns (t_final, n_events, failure
-    code, number of history samples written, accepted steps, rejected steps, exponential steps).
+        bmat, gram, rows, q_vel, wind_grad, rates0, t_start, n_ev_start, n_hist_start, h_start,
+        settle_after):
+    """Integrate from ``t_start`` to ``t_end`` or the first failure; returns (t_final, n_events,
+    failure code, number of history samples written, accepted steps, rejected steps,
+    exponential steps, the next step size).
 
     With ``use_static``, a step that starts on a sample while every spring and strip is in its
     static regime (``reg_s``, ``fs_s``) is first tried as one exponential step to the next sample
@@ -89,6 +95,13 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     refused for its error, as two half steps; if an event function changes sign in one or a
     half step's error estimate is too large, Dormand-Prince takes over from there (after an
     error refusal, for the next ``STATIC_PAUSE`` samples).
+
+    With ``settle_after`` > 0, the run stops (failure code ``STOP_SETTLED``) at a sample once
+    the dock has spent that many samples without an event in a regime other than the static
+    one, with no cap crushing and no strip slipping: the caller makes the matrices for that
+    regime at the state reached and calls again to go on (``t_start``, ``n_ev_start``,
+    ``n_hist_start``, ``h_start`` from the stop; ``t_start`` = 0 starts a run: the initial
+    sample and the start event are written and ``h_start`` is not used).
 
     ``x``, ``reg``, ``dp``, ``fs`` are updated in place (the final state); ``dc0``, ``tc0`` hold
     the compression of every detached cap and the time it let go (start with ``dc0 = dp``). Histories are written
@@ -124,6 +137,9 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     # exponential steps in the static regime: work arrays, and the sample before which none is
     # tried again after an error refusal
     nm_s = mats.shape[1]
+    mats_t = np.empty_like(mats)  # transposed, as _static_step takes them
+    for k in range(mats.shape[0]):
+        mats_t[k] = mats[k].T
     wk = np.zeros((8, 3 * nm_s))
     xm_s = np.zeros(nx)
     fm_s = np.zeros(nx)
@@ -134,32 +150,37 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
     xm_n = np.zeros(ns)
     xm_t = np.zeros(ns)
     n_in = ag_y.shape[0]
-    t = 0.0
-    n_ev = 0
-    ev_t[0] = 0.0
-    ev_kind[0] = EV_START
-    ev_index[0] = -1
-    n_ev = 1
+    n_samples = hist_x.shape[0]
     failure = 0
-    n_hist = 0
     n_acc = 0
     n_rej = 0
-    h = min(h_max, 1e-4)
-    # the first history sample is the initial state
-    kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
-    contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
-                   delta_dot, vt, fe, fn, normal, tang)
-    n_samples = hist_x.shape[0]
-    _sample(0, x, normal, tang, hist_x, hist_n, hist_t)
-    n_hist = 1
-    _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n)
-    rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
-        dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
-    event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt, delta,
-                 delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
-    failure, n_ev = _settle(t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs,
-                            opt, delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0,
-                            acc, n_ev, ev_t, ev_kind, ev_index)
+    t = t_start
+    # the sample from which a stop for a settled regime counts its event-free samples
+    quiet_from = int(math.floor(t / dt_rec + 0.5))
+    if t_start == 0.0:
+        ev_t[0] = 0.0
+        ev_kind[0] = EV_START
+        ev_index[0] = -1
+        n_ev = 1
+        h = min(h_max, 1e-4)
+        # the first history sample is the initial state
+        kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)
+        contact_forces(x, 6 * nb, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta,
+                       delta_dot, vt, fe, fn, normal, tang)
+        _sample(0, x, normal, tang, hist_x, hist_n, hist_t)
+        n_hist = 1
+        _track(nsp, ns, fe, fn, normal, tang, peak_fe, peak_fn, peak_util, peak_n)
+        rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y,
+            ag_z, dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
+        event_values(t, x, nb, ns, strip_f, strip_i, spring_f, reg, dp, dc0, tc0, fs, opt,
+                     delta, delta_dot, vt, pos, fe, fn, normal, tang, theta_c, g0)
+        failure, n_ev = _settle(t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0,
+                                tc0, fs, opt, delta, delta_dot, vt, pos, fe, fn, normal, tang,
+                                theta_c, g0, acc, n_ev, ev_t, ev_kind, ev_index)
+    else:
+        n_ev = n_ev_start
+        n_hist = n_hist_start
+        h = h_start
     regime_sums(strip_i, spring_f, reg, dp, sums)
     rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, fs, opt, ag_y, ag_z,
         dt_rec, delta, delta_dot, vt, pos, fe, fn, normal, tang, k1)
@@ -174,6 +195,11 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
         if t_end - t < 1e-12 * dt_rec:
             break
         ks = int(math.floor(t / dt_rec + 0.5))
+        if (settle_after > 0 and ks - quiet_from >= settle_after
+                and abs(t - ks * dt_rec) <= 1e-9 * dt_rec and ks + 1 < n_in
+                and not _in_static(reg, fs, reg_s, fs_s) and _settled(reg, fs)):
+            failure = STOP_SETTLED
+            break
         if (use_static and ks >= static_from and abs(t - ks * dt_rec) <= 1e-9 * dt_rec
                 and ks + 1 < n_in and t_next <= t_end + 1e-12 * dt_rec
                 and _in_static(reg, fs, reg_s, fs_s)):
@@ -191,7 +217,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
                                     ag_z[ks] + slope_z * off, slope_y, slope_z, x, k1, g0, nb,
                                     ns, mass, inertia, strip_f, strip_i, spring_f, reg, dp, dc0,
                                     tc0, fs, opt, theta_c, ag_y, ag_z, dt_rec, rtol, atol, xs,
-                                    mats, bmat, gram, rows, q_vel, wind_grad, rates0, wk, x1,
+                                    mats_t, bmat, gram, rows, q_vel, wind_grad, rates0, wk, x1,
                                     xm_s, k7, fm_s, g1, gvm_s,
                                     (delta, delta_dot, vt, pos, fe, fn, normal, tang),
                                     (m_delta, m_delta_dot, m_vt, m_pos, m_fe, m_fn, m_normal,
@@ -363,6 +389,7 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
                       n_start, normal, xe, m_delta, m_delta_dot, m_vt, m_pos, m_fe, m_fn,
                       m_normal, m_tang, peak_fe, peak_fn, peak_util, peak_n)
         if first >= 0:
+            quiet_from = int(math.floor(t / dt_rec)) + 1
             kind, index = _transition(first, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg,
                                       dp, dc0, tc0, fs, delta, normal, tang, acc)
             n_ev = _log(n_ev, t, kind, index, ev_t, ev_kind, ev_index)
@@ -400,6 +427,8 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
         # step-size controller (elementary, order 5 solution with a 4th-order error estimate;
         # Hairer's stabilised controller was tried: fewer rejections, as many evaluations)
         h = h * min(5.0, max(0.2, 0.9 * max(err, 1e-10) ** -0.2))
+    if failure == STOP_SETTLED:
+        return t, n_ev, failure, n_hist, n_acc, n_rej, n_static, h
     # energy left in detached caps is not lost yet: count only what they have shed
     for i in range(nsp):
         if reg[i] == R_FREE and dc0[i] > dp[i]:
@@ -407,7 +436,20 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
             acc[A_CAP_RELAX] -= 0.5 * spring_f[i, PF_K] * rem * rem
             dc0[i] = dp[i] + rem
             tc0[i] = t
-    return t, n_ev, failure, n_hist, n_acc, n_rej, n_static
+    return t, n_ev, failure, n_hist, n_acc, n_rej, n_static, h
+
+
+@njit(cache=True)
+def _settled(reg, fs):
+    """Whether a regime can have exponential steps made for it: no cap crushing (its set
+    grows) and no strip slipping (its friction force is not linear in the state)."""
+    for i in range(reg.shape[0]):
+        if reg[i] == R_CRUSH:
+            return False
+    for j in range(fs.shape[0]):
+        if fs[j] != F_STICK and fs[j] != F_FREE:
+            return False
+    return True
 
 
 @njit(cache=True, inline="always")
@@ -485,16 +527,9 @@ def _track_inside(hi, r, stage_n, nb, ns, nsp, strip_f, strip_i, spring_f, reg, 
     best_s = -1.0
     best_gain = 0.0
     for j in range(ns):
-        n0, nm, n1 = n_start[j], normal[j], n_end[j]
-        a = 2.0 * (n1 - 2.0 * nm + n0)
-        b = 4.0 * nm - 3.0 * n0 - n1
-        if a < 0.0:
-            s = -b / (2.0 * a)
-            if 0.0 < s < 1.0:
-                top = n0 - b * b / (4.0 * a)
-                gain = (top - peak_n[j]) / max(abs(peak_n[j]), 1e-300)
-                if gain > best_gain:
-                    best_s, best_gain = s, gain
+        s, gain = _vertex(n_start[j], normal[j], n_end[j], peak_n[j])
+        if gain > best_gain:
+            best_s, best_gain = s, gain
     if best_s > 0.0:
         dense(r, best_s * hi, xe)
         kinematics(xe, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos)

@@ -63,7 +63,7 @@ from shipblock.section._forces import rhs
 from shipblock.section._kernel import _force_arrays
 from shipblock.section.model import Assembly, InitialState
 
-__all__ = ["StaticSteps", "static_steps"]
+__all__ = ["StaticSteps", "settled_steps", "static_steps"]
 
 #: Matrices of :attr:`StaticSteps.mats`, in this order (H: at h/2, Q: at h/4, C: the error
 #: estimate's for a step of h and of h/2).
@@ -163,18 +163,41 @@ def static_steps(asm: Assembly, init: InitialState, dt: float) -> StaticSteps:
     The linear algebra runs on one BLAS thread: its results do not depend on how many threads
     a process has (a Dask worker has one), so a study gives the same bits everywhere.
     """
+    return _regime_steps(asm, init.x, init.regime, init.friction,
+                         np.zeros(asm.spring_f.shape[0]), dt)
+
+
+def settled_steps(asm: Assembly, x: np.ndarray, regime: np.ndarray, friction: np.ndarray,
+                  plastic_set: np.ndarray, dt: float) -> StaticSteps:
+    """The matrices of exponential steps of length ``dt`` in the regime a run has settled in.
+
+    As :func:`static_steps`, linearised at the positions (and stick-spring extensions) of ``x``
+    at rest: ``x_s`` is ``x`` with its velocities set to zero, so that the damping's and the
+    wind's forms are those of motion about it; ``x`` need not be an equilibrium (what it leaves
+    unbalanced is part of the remainder ``g``, integrated as the input is). The kernel stops
+    for these (:data:`shipblock.section._kernel.STOP_SETTLED`) when the dock has spent a while
+    without an event in a regime (springs' contacts, strips' stick or free states) other than
+    the static one, typically after strong motion leaves caps open and blocks shifted.
+    """
+    nb = asm.n_bodies
+    x_s = np.array(x, dtype=float)
+    x_s[3 * nb:6 * nb] = 0.0
+    return _regime_steps(asm, x_s, regime, friction, plastic_set, dt)
+
+
+def _regime_steps(asm, x_s, regime, friction, plastic_set, dt) -> StaticSteps:
+    """:func:`static_steps` for the regime ``(regime, friction)``, linearised at ``x_s``, on one
+    BLAS thread (its results do not depend on how many threads a process has)."""
     with threadpool_limits(limits=1, user_api="blas"):
-        return _static_steps(asm, init, dt)
+        return _steps(asm, np.array(x_s, dtype=float), np.array(regime, dtype=np.int64),
+                      np.array(friction, dtype=np.int64), np.array(plastic_set, dtype=float), dt)
 
 
-def _static_steps(asm: Assembly, init: InitialState, dt: float) -> StaticSteps:
+def _steps(asm: Assembly, x_s, reg, fs, dp, dt: float) -> StaticSteps:
     nb, ns = asm.n_bodies, asm.n_strips
-    nsp = asm.spring_f.shape[0]
     nm = 6 * nb + ns
     o_e = nm
-    x_s = init.x.copy()
-    reg, fs, dp = init.regime.copy(), init.friction.copy(), np.zeros(nsp)
-    work = _force_arrays(nsp, ns)
+    work = _force_arrays(asm.spring_f.shape[0], ns)
     out = np.zeros(x_s.size)
 
     def f(x, ay=0.0, az=0.0):

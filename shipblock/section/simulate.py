@@ -16,7 +16,7 @@ import numpy as np
 from shipblock import checks
 from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.section import _kernel as K
-from shipblock.section.exponential import StaticSteps, static_steps
+from shipblock.section.exponential import StaticSteps, settled_steps, static_steps
 from shipblock.section.model import Assembly, assemble, static_state
 from shipblock.section.parameters import DockSection
 
@@ -30,6 +30,11 @@ DEFAULT_ATOL = 1e-9
 DEFAULT_SEPARATION_HEIGHT = 0.02
 #: Most events in one run before it stops as stalled.
 DEFAULT_MAX_EVENTS = 1_000_000
+#: exponential steps for a regime other than the static one are made once the dock has spent this
+#: long in it without an event [s], for at most this many regimes per run (session 20's
+#: measurement: docs/user_guide/section.rst, "Integrator")
+SETTLE_SECONDS = 1.0
+SETTLED_REGIMES = 2
 
 EVENT_NAMES = {
     K.EV_START: "start", K.EV_CLOSE: "spring_closes", K.EV_DETACH: "spring_detaches",
@@ -80,7 +85,8 @@ class SectionResult:
     energy : dict
         Terms of the energy balance at the end [J] and its relative residual.
     stats : dict
-        Accepted and rejected Dormand-Prince steps, exponential steps (static regime), events.
+        Accepted and rejected Dormand-Prince steps, exponential steps, regimes settled in (for
+        which the run made exponential steps besides the static regime), events.
     plastic_set : ndarray
         Permanent set of every spring at the end [m] (strips in :attr:`strip_names` order, the
         section's ``n_springs`` springs each).
@@ -200,7 +206,10 @@ def simulate_section(section: DockSection, motion, vertical=None, dt: float | No
     and integrates the section's equations (:mod:`shipblock.section.model`) with a Dormand-Prince
     5(4) method, steps ending on the input samples (the input is linear between them); while every
     spring and strip is in the regime it has at rest, one exponential step per sample instead
-    (:mod:`shipblock.section.exponential`: the cap modes integrated exactly). Every
+    (:mod:`shipblock.section.exponential`: the cap modes integrated exactly), and the same in a
+    regime the dock has settled in after strong motion (``SETTLE_SECONDS`` without an event, no
+    cap crushing, no strip slipping; matrices made then, for at most ``SETTLED_REGIMES``
+    regimes per run: :func:`~shipblock.section.exponential.settled_steps`). Every
     change of a contact law (a spring closing, letting go, starting or ending to crush; a strip
     slipping or sticking) and every failure is located in time on the step's dense output; the
     run stops at the first failure.
@@ -227,7 +236,8 @@ def simulate_section(section: DockSection, motion, vertical=None, dt: float | No
         Velocities ``(v_y, v_z, omega)`` of every body (the ship, then the moving lines) added to
         the static state at t = 0 [m/s, rad/s], shape (n_bodies, 3); within 10 m/s and 10 rad/s.
     exponential_steps : bool
-        Take exponential steps in the static regime (default); False: Dormand-Prince throughout
+        Take exponential steps in the static and settled regimes (default); False: Dormand-Prince
+        throughout
         (the same response to the tolerance, 3-4 times the CPU on a quiet record).
 
     Returns
@@ -313,12 +323,26 @@ def _run(section, asm, init, ah, av, dt, rtol, atol, max_events, initial_velocit
         use_static = False
     else:
         use_static = True
-    t, n_ev, failure, n_hist, n_acc, n_rej, n_static = K.run(
-        x, reg, dp, dc0, tc0, fs, nb, asm.mass, asm.inertia, asm.strip_f, asm.strip_i,
-        asm.spring_f, asm.opt, asm.theta_c, ah, av, dt, t_end, rtol, atol, dt, max_events,
-        hist_x, hist_n, hist_t, ev_t, ev_kind, ev_index, acc, peak_fe, peak_fn, peak_util, peak_n,
-        use_static, steps.x_s, steps.regime, steps.friction, steps.mats, steps.b, steps.gram,
-        steps.rows, steps.q_vel, steps.wind_grad, steps.rates0)
+    # the kernel stops when the dock has settled in a regime other than the static one (after
+    # strong motion, caps left open): its matrices are made at the state reached and the run goes
+    # on (at most SETTLED_REGIMES times: each costs about as much as the static regime's)
+    t, n_ev, n_hist, h = 0.0, 0, 0, 0.0
+    n_acc = n_rej = n_static = n_settled = 0
+    while True:
+        settle_after = (int(round(SETTLE_SECONDS / dt))
+                        if use_static and n_settled < SETTLED_REGIMES else 0)
+        t, n_ev, failure, n_hist, acc_i, rej_i, static_i, h = K.run(
+            x, reg, dp, dc0, tc0, fs, nb, asm.mass, asm.inertia, asm.strip_f, asm.strip_i,
+            asm.spring_f, asm.opt, asm.theta_c, ah, av, dt, t_end, rtol, atol, dt, max_events,
+            hist_x, hist_n, hist_t, ev_t, ev_kind, ev_index, acc, peak_fe, peak_fn, peak_util,
+            peak_n, use_static, steps.x_s, steps.regime, steps.friction, steps.mats, steps.b,
+            steps.gram, steps.rows, steps.q_vel, steps.wind_grad, steps.rates0, t, n_ev, n_hist,
+            h, settle_after)
+        n_acc, n_rej, n_static = n_acc + acc_i, n_rej + rej_i, n_static + static_i
+        if failure != K.STOP_SETTLED:
+            break
+        n_settled += 1
+        steps = settled_steps(asm, x, reg, fs, dp, dt)
     e1 = energy_terms(asm, x, reg, dp, dc0, tc0, fs, t)
     o = 6 * nb + ns
     w_ground, w_wind, d_damp, d_fric = x[o:o + 4]
@@ -345,7 +369,8 @@ def _run(section, asm, init, ah, av, dt, rtol, atol, max_events, initial_velocit
                    ev_t[:min(n_ev, log)], ev_kind[:min(n_ev, log)], ev_index[:min(n_ev, log)],
                    failure, dp, peak_fe, peak_fn, peak_util, peak_n, energy,
                    {"accepted_steps": int(n_acc), "rejected_steps": int(n_rej),
-                    "exponential_steps": int(n_static), "events": int(n_ev)})
+                    "exponential_steps": int(n_static), "settled_regimes": n_settled,
+                    "events": int(n_ev)})
 
 
 def _result(section, asm, init, hx, hn, ht, dt, t_final, ev_t, ev_kind, ev_index, failure, dp,
