@@ -16,6 +16,7 @@ from shipblock.plot import (
     plot_fragility,
     plot_ida,
     plot_median_sweep,
+    plot_section_response,
     study_caption,
     sweep_selection,
     sweep_text,
@@ -231,3 +232,32 @@ def test_cloud_figure_draws_each_records_outcome_at_its_intensity(tmp_path):
                                   ds["exceeded"].sel(limit_state="ship_slip").values)
     fitted = np.isfinite(ds["median"].values).any()
     assert ("lines: lognormal fit" in title) == bool(fitted)
+
+
+def _section_histories(sway_peak_m, half_width_m=0.61):
+    """A dataset shaped as a section run's histories, its sway one sine of ``sway_peak_m``."""
+    t = np.arange(0.0, 10.0, 0.01)
+    load = np.full(t.size, 3e5)
+    return xr.Dataset(
+        {"ship_sway": ("time", sway_peak_m * np.sin(t)), "ship_roll": ("time", 1e-4 * np.sin(t)),
+         "keel_top_normal": ("time", load), "ground_acceleration_h": ("time", np.sin(3 * t)),
+         "ground_acceleration_v": ("time", np.zeros(t.size))},
+        coords={"time": t},
+        attrs={"keel_cap_half_width": half_width_m, "keel_block_capacity": 3.288e6,
+               "failure_name": "none", "record_description": "a test record"})
+
+
+@pytest.mark.parametrize(("sway_m", "edges_drawn"), [(0.009, False), (0.3, True)])
+def test_the_sway_panel_shows_a_small_sway_at_its_own_scale(sway_m, edges_drawn):
+    """A 9 mm sway against a 610 mm keel cap's edge was a flat line: it has its own scale and
+    the legend names the edge; a sway of half the half-width is drawn against the edges."""
+    axes = plot_section_response(_section_histories(sway_m))
+    ax_s = axes[1]
+    low, high = ax_s.get_ylim()
+    labels = [t.get_text() for t in ax_s.get_legend().get_texts()]
+    if edges_drawn:
+        assert high >= 610.0 and low <= -610.0
+        assert labels == ["keel cap's edge"]
+    else:
+        assert 9.0 <= high < 12.0 and -12.0 < low <= -9.0  # the sway fills the panel
+        assert labels == ["keel cap's edge at \u00b1610 mm (off scale)"]

@@ -18,6 +18,11 @@ from shipblock.units import STANDARD_GRAVITY
 __all__ = ["is_section_response", "plot_section_response"]
 
 
+#: The sway panel draws the keel cap's edges when the peak sway reaches this fraction of the
+#: cap's half-width; below it the sway has its own scale and the legend names the edge.
+EDGE_SHOWN = 0.1
+
+
 def is_section_response(ds) -> bool:
     """Whether ``ds`` holds the histories of one run of the dock-section model."""
     return hasattr(ds, "data_vars") and "ship_sway" in ds and "time" in ds.dims
@@ -27,7 +32,8 @@ def plot_section_response(run, axes=None, record=None):
     """Histories of one section run: ground acceleration, sway, roll and block loads.
 
     The sway panel shows the keel's offset from the keel blocks' tops against the keel cap's
-    half-width (where the ship slides off the cap); the load panel each line's top-cap normal
+    half-width (where the ship slides off the cap; named in the legend, off scale, when the peak
+    sway is below ``EDGE_SHOWN`` of it); the load panel each line's top-cap normal
     force per block over the block's capacity (1: the capacity), so that the capacity-ratio EDPs
     (``keel_load_ratio``, ``side_load_ratio``) are the peaks of these curves. The title names the
     record (``record``, or the dataset's own line) and the outcome (failure and peaks).
@@ -65,12 +71,19 @@ def plot_section_response(run, axes=None, record=None):
                       label="vertical")
         ax_g.legend(loc="upper right", fontsize=8, ncol=2)
     ax_g.set_ylabel("ground acc. [g]")
-    ax_s.plot(t, 1e3 * ds["ship_sway"].values, color="tab:blue", lw=1.0)
+    sway_mm = 1e3 * ds["ship_sway"].values
+    ax_s.plot(t, sway_mm, color="tab:blue", lw=1.0)
     half = ds.attrs.get("keel_cap_half_width")
     if half is not None:
-        for sign in (1, -1):
-            ax_s.axhline(sign * 1e3 * float(half), color="tab:red", lw=0.8, ls="--",
-                         label="keel cap's edge" if sign > 0 else None)
+        edge_mm = 1e3 * float(half)
+        peak_mm = float(np.nanmax(np.abs(sway_mm), initial=0.0))
+        if peak_mm >= EDGE_SHOWN * edge_mm:
+            for sign in (1, -1):
+                ax_s.axhline(sign * edge_mm, color="tab:red", lw=0.8, ls="--",
+                             label="keel cap's edge" if sign > 0 else None)
+        else:  # at the edge's scale a small sway is a flat line: its own scale, the edge named
+            ax_s.plot([], [], color="tab:red", lw=0.8, ls="--",
+                      label=f"keel cap's edge at \u00b1{edge_mm:.0f} mm (off scale)")
         ax_s.legend(loc="upper right", fontsize=8)
     ax_s.set_ylabel("sway [mm]")
     ax_r.plot(t, 1e3 * ds["ship_roll"].values, color="tab:green", lw=1.0)
