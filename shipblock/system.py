@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import MISSING, asdict, dataclass, fields
 from functools import cached_property
 
 import numpy as np
@@ -332,6 +332,10 @@ class ShipBlockSystem:
         unknown = sorted(set(values) - known)
         if unknown:
             raise ParameterError(f"{source}: unknown system parameter(s) {unknown}; known: {sorted(known)}")
+        missing = [f.name for f in fields(cls) if f.name not in values
+                   and f.default is MISSING and f.default_factory is MISSING]
+        if missing:
+            raise ParameterTypeError(f"{source}: missing system parameter(s) {missing}")
         try:
             system = cls(**si_values(values))
         except ParameterError as exc:  # also a ParameterTypeError: keep the type

@@ -142,3 +142,40 @@ def test_no_exponential_steps_reaches_the_section_solver(tmp_path, records, caps
              'mu_k_ground = 0.55\nmu_s_ship = 0.35\nmu_k_ship = 0.3\n')
     assert _simulate(tmp_path, records, "--no-exponential-steps", system=rigid) == 2
     assert "--no-exponential-steps applies to the section model" in capsys.readouterr().err
+
+
+def test_the_system_files_solver_table_reaches_the_run(tmp_path, records, capsys):
+    """A ``[solver]`` table beside ``[system]`` (a pipeline's, the same keys and checks) sets the
+    run's options, where it was ignored: ``max_events = 3`` stops the real motion as stalled
+    after three events, the options used are stored with the response; a flag overrides the
+    file; an unknown key is refused naming the file and the key, before the record is read."""
+    out = tmp_path / "solver.nc"
+    with_solver = SYSTEM + "\n[solver]\nmax_events = 3\nseparation_height = 0.05\nrtol = 1e-7\n"
+    assert _simulate(tmp_path, records, "-o", str(out), "--rtol", "1e-8",
+                     system=with_solver) == 0
+    assert "stalled at t =" in capsys.readouterr().out
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["failure_name"] == "stalled"
+        assert ds.attrs["solver_max_events"] == 3
+        assert ds.attrs["solver_separation_height"] == 0.05
+        assert ds.attrs["solver_rtol"] == 1e-8  # the flag's, not the file's 1e-7
+    assert _simulate(tmp_path, records, system=SYSTEM + "\n[solver]\nmax_event = 3\n") == 2
+    err = capsys.readouterr().err
+    assert "dock.toml" in err and "[solver.max_event] unknown key 'max_event'" in err
+
+
+def test_a_plain_rigid_system_file_names_its_missing_keys(tmp_path, records, capsys):
+    """A plain ``[system]`` table (no ``model``) without its friction coefficients: the missing
+    keys named, not a Python signature; its ``[solver]`` table reaches the rigid solver."""
+    plain = ('[system]\nship_mass = "5000 t"\nblock_mass = "1.2 t"\nn_blocks = 150\n'
+             'half_width = 0.3\nhalf_height = 0.6\n')
+    assert _simulate(tmp_path, records, system=plain) != 0
+    err = capsys.readouterr().err
+    assert "missing system parameter(s) ['mu_s_ground', 'mu_k_ground', 'mu_s_ship', " in err
+    out = tmp_path / "rigid.nc"
+    full = plain + ('mu_s_ground = 0.6\nmu_k_ground = 0.55\nmu_s_ship = 0.35\nmu_k_ship = 0.3\n'
+                    '[solver]\nrtol = 1e-6\n')
+    assert _simulate(tmp_path, records, "-o", str(out), system=full) == 0
+    capsys.readouterr()
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["solver_rtol"] == 1e-6

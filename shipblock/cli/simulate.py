@@ -65,11 +65,14 @@ RIGID_RTOL = 1e-8
 
 
 def _solver_options(args, model) -> dict:
-    """``--rtol`` and ``--atol`` as given, each checked against the range ``model`` declares
-    for its ``[solver]`` option; a value outside it is an error naming the flag."""
+    """The ``[solver]`` table of ``--system``'s file (as a pipeline's, checked and named the
+    same way), then ``--rtol`` and ``--atol`` as given, each checked against the range
+    ``model`` declares for its ``[solver]`` option (a value outside it is an error naming the
+    flag), and ``--no-exponential-steps``."""
+    from shipblock.fragility.schema import load_solver
     from shipblock.models.base import FieldError
 
-    options = {}
+    options = load_solver(args.system, model) if args.system else {}
     for name in ("rtol", "atol"):
         value = getattr(args, name)
         if value is None:
@@ -128,14 +131,14 @@ def cmd_simulate(args):
         chosen = None
     else:
         system = chosen[1]
+    model = get_model(DEFAULT_MODEL) if chosen is None else chosen[0]
+    options = _solver_options(args, model)  # the file's and flags' errors before the record's
     motion = _load_motion(args)
     ax, ay, scale = _scaled_input(args, motion)
     log.info("simulating %d samples at dt = %g s", ax.size, motion.dt)
     sys.stdout.write(f"horizontal  {_horizontal_line(motion)}\n")
     name = motion.name
     record = record_text(motion, scale)
-    model = get_model(DEFAULT_MODEL) if chosen is None else chosen[0]
-    options = _solver_options(args, model)
     if chosen is not None:
         res = model.simulate(system, ax, ay, motion.dt, **options)
         _section_report(model, system, res, name, args.events)
@@ -144,10 +147,9 @@ def cmd_simulate(args):
         _report(res, name, args.events)
     if args.output:
         ds = res.to_dataset()
-        for key in ("rtol", "atol"):  # the tolerances used (a rigid result states its own)
-            ds.attrs.setdefault(f"solver_{key}", options.get(key, model.options[key].default))
-        if "exponential_steps" in model.options:
-            ds.attrs["solver_exponential_steps"] = int(options.get("exponential_steps", True))
+        for key, field in model.options.items():  # the options used (a rigid result states
+            used = options.get(key, field.default)  # its tolerances itself)
+            ds.attrs.setdefault(f"solver_{key}", int(used) if isinstance(used, bool) else used)
         ds.attrs["record"] = str(name)
         ds.attrs["record_description"] = record
         ds.attrs["processing"] = "\n".join(motion.metadata.get("processing", []) or [])

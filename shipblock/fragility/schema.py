@@ -79,8 +79,8 @@ from shipblock.fragility.limit_states import LimitState, parse_limit_states
 from shipblock.models import DEFAULT_MODEL, FieldError, Model, get_model
 from shipblock.units import STANDARD_GRAVITY, acceleration_to_si, velocity_to_si
 
-__all__ = ["HistoryRequest", "Pipeline", "PipelineError", "load_pipeline", "load_system",
-           "parse_pipeline"]
+__all__ = ["HistoryRequest", "Pipeline", "PipelineError", "load_pipeline", "load_solver",
+           "load_system", "parse_pipeline"]
 
 logger = logging.getLogger(__name__)
 
@@ -246,6 +246,20 @@ def load_system(path) -> tuple[Model, object]:
     model = _model(table, source)
     check_table(table, "system", source, model)
     return model, _system(table, model, source)
+
+
+def load_solver(path, model: Model) -> dict:
+    """The solver options a file's ``[solver]`` table gives, read as a pipeline's (its keys,
+    units and ``model``'s checks), for a single run (``shipblock simulate --system FILE``): only
+    the options the table names; ``{}`` without a table. Raises :class:`PipelineError` naming
+    the file and the key (``solver.<key>``)."""
+    source = str(checks.pathname(path, "path", "a system TOML file"))
+    table = checks.toml_file(source, "system file", error=_file_error).get("solver", {})
+    if not isinstance(table, Mapping):
+        raise PipelineError("solver", f"must be a table, got {type(table).__name__}", source)
+    check_table(table, "solver", source, model)
+    options = _solver(table, model, source)
+    return {key: options[key] for key in table}
 
 
 def load_pipeline(path) -> Pipeline:

@@ -247,8 +247,8 @@ OPTIONS: Mapping[str, Field] = MappingProxyType({
                         "as a solver error", "1", default=DEFAULT_MAX_EVENTS, low=1,
                         high=10**9),
     "exponential_steps": Field("exponential_steps", (bool,), "one exponential step per sample "
-                               "while the dock is in its static regime (false: Dormand-Prince "
-                               "throughout)", "1", default=True),
+                               "while the dock is in its static regime or one it has settled "
+                               "in (false: Dormand-Prince throughout)", "1", default=True),
 })
 
 # ------------------------------------------------------------------------------------------
