@@ -157,6 +157,27 @@ def test_one_column_text_with_dt_reads_the_at2_peak(tmp_path, capsys):
     assert f"{np.abs(at2.horizontal).max() / STANDARD_GRAVITY:.4f}" in out
 
 
+@needs_outside
+@pytest.mark.parametrize(("flag", "value", "readers"), [
+    ("--dt", "0.01", "SHIPBLOCK_TEXT"),
+    ("--resample-rate", "100", "SHIPBLOCK_USC and SHIPBLOCK_SMC"),
+    ("--resample-interval", "0.01", "SHIPBLOCK_DMG"),
+])
+def test_a_read_option_of_another_format_is_refused_not_ignored(capsys, flag, value, readers):
+    """--dt 0.01 given for an AT2 file (which states 0.005 s) was ignored without a word; each
+    format's own option, given for a file whose reader does not take it, is refused naming
+    the flag, the catalogue key and the formats it is for. The same for the shipped MiniSEED
+    records (obspy's reader)."""
+    key = flag[2:].replace("-", "_")
+    code, _, err = run(capsys, "info", str(LOMA), flag, value, "--processing", "none")
+    assert code == 2
+    assert f"{key}={float(value)!r} applies to {readers} files only" in err
+    assert "this file is SHIPBLOCK_AT2" in err and f"leave out {flag}, catalogue key {key}" in err
+    shipped = Path(__file__).resolve().parents[1] / "records" / "south-napa-2014" / "NP.1737.mseed"
+    with pytest.raises(ParameterError, match=f"{key}=.* applies to .* this file is MSEED"):
+        read_motion(str(shipped), **{key: float(value)})
+
+
 def test_velocity_text_with_units_and_differentiate(tmp_path, capsys):
     # v = V sin(2 pi f t) cm/s: a = 2 pi f V cos(2 pi f t), peak 2 pi f V cm/s^2
     dt, f, amplitude = 0.001, 1.0, 5.0

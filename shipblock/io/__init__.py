@@ -118,6 +118,11 @@ _NUMERIC_KEYWORDS = {
 }
 
 
+#: Keywords that only some of shipblock's readers take: given for a file of another format they
+#: would be ignored without a word (``dt`` for an AT2 file, which states its own interval).
+_FORMAT_KEYWORDS = ("dt", "resample_rate", "resample_interval", "data_type")
+
+
 #: Keywords of :func:`obspy.read` and of shipblock's own readers: known without loading the
 #: other plug-ins.
 _OWN_READER_KEYWORDS = frozenset(set(checks.keyword_names(obspy.read, 1)).union(
@@ -279,6 +284,22 @@ def _check_trace(trace, name: str) -> None:
             check_plausible_samples(trace.data, name, what)
 
 
+def _check_format_keywords(stream, name: str, kwargs) -> None:
+    """Refuse a format's own keyword (:data:`_FORMAT_KEYWORDS`) given for a file of a format
+    whose reader does not take it, naming the keyword and the formats that do."""
+    fmt = getattr(stream[0].stats, "_format", None)
+    reader = FORMATS[fmt][1] if fmt in FORMATS else None
+    takes = set(checks.keyword_names(reader, 1)) if reader is not None else set()
+    for key in _FORMAT_KEYWORDS:
+        if kwargs.get(key) is None or key in takes:
+            continue
+        which = [f for f, (_, r) in FORMATS.items() if key in checks.keyword_names(r, 1)]
+        raise ParameterError(
+            f"{name}: {key}={kwargs[key]!r} applies to {' and '.join(which)} files only; this "
+            f"file is {fmt or 'of another format'}, whose reader does not use it (leave out "
+            f"--{key.replace('_', '-')}, catalogue key {key}, Python {key}=)")
+
+
 def read_record(path, format: str | None = None, units: str | None = None, **kwargs):
     """Read one record file into an obspy Stream.
 
@@ -353,6 +374,8 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
                 raise RecordError(name, f"cannot be read: {exc}") from exc
             if format is None and _looks_like_plain_text(name):
                 stream = text.read_text_record(name, units=units, **kwargs)
+                for trace in stream:
+                    trace.stats._format = text.FORMAT
             else:
                 raise RecordError(
                     name,
@@ -368,6 +391,7 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
         warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
     if len(stream) == 0:
         raise RecordError(name, "holds no traces")
+    _check_format_keywords(stream, name, kwargs)
     empty = [tr.id for tr in stream if tr.stats.npts == 0 or len(tr.data) == 0]
     if empty:
         raise RecordError(name, f"channel {empty[0]} has no samples (corrupt or truncated file?)")
