@@ -12,10 +12,12 @@ sign or factor error in a load path would give.
 import numpy as np
 import pytest
 
+from shipblock.bench.section_campaign import random_case
 from shipblock.errors import ParameterError
 from shipblock.section import NAVY_BLOCK, Block, BlockLine, Cap, DockSection, Ship, Wind
 from shipblock.section import _kernel as K
-from shipblock.section.model import assemble, static_state
+from shipblock.section.model import NoStaticSolution, assemble, static_state
+from shipblock.section.simulate import rest_state, simulate_section
 
 G = 9.80665
 
@@ -159,8 +161,10 @@ def test_caps_crushing_at_rest_are_refused_naming_the_line():
 
 
 def test_a_side_line_that_would_slide_at_rest_is_refused():
-    """One side line under a sloped hull: the static state with the strips sticking needs more
-    friction than mu_s gives; the dock is refused naming the line, not started out of its cone."""
+    """One side line under a sloped hull: the static state with the strips sticking from the
+    touching position needs more friction than mu_s gives; static_state refuses it naming the
+    line, not started out of its cone (rest_state then looks for the state the dock lands in:
+    test_a_side_line_that_slips_as_the_ship_lands_starts_from_where_it_stuck)."""
     slick = Cap(mu_s=0.05, mu_k=0.05)
     side = BlockLine(block=Block(top=slick, bottom=slick, half_height=24 * 0.0254 + 0.15),
                      n_blocks=2, offset=3.5, hull_height=0.3, hull_slope=0.3)
@@ -199,3 +203,59 @@ def test_side_lines_preloaded_by_an_interference_lift_the_ship_off_the_keel():
     assert vertical == pytest.approx(weight, rel=1e-4)
     # G off to starboard: the starboard line carries more
     assert init.normal[sides_top[1]] > init.normal[sides_top[0]]
+
+
+def _at_rest(dock, seconds=10.0):
+    """Largest displacement of any body and the events of a run under no ground motion from the
+    dock's static state (a second implementation: the dynamics keep an equilibrium still)."""
+    n = int(seconds / 0.005) + 1
+    res = simulate_section(dock, np.zeros(n), np.zeros(n), 0.005)
+    moved = max([np.abs(res.ship).max()] + [np.abs(a).max() for a in res.lines.values()])
+    return moved, [e.kind for e in res.events]
+
+
+def test_a_static_state_powell_misses_from_the_start_is_found_from_where_the_dock_rests():
+    """Campaign case 0 of seed 29 (two moving side lines, steady wind): Powell's method stalls
+    from the stress-free start, so the dock was refused as having no static solution; left under
+    gravity alone it comes to rest, and the solve from there converges. The state is an
+    equilibrium the dynamics keep: 10 s under no ground motion move no body by 1e-12 m."""
+    dock, _, _ = random_case(29, 0)
+    asm = assemble(dock)
+    with pytest.raises(NoStaticSolution):
+        static_state(asm)
+    init = rest_state(asm)
+    assert np.all(init.regime != K.R_CRUSH)
+    assert np.all(np.isin(init.friction, (K.F_STICK, K.F_FREE)))
+    moved, events = _at_rest(dock)
+    assert moved < 1e-12 and events == ["start"]
+
+
+def test_a_side_line_that_slips_as_the_ship_lands_starts_from_where_it_stuck():
+    """The dock of test_a_side_line_that_would_slide_at_rest_is_refused: with its stick spring
+    stretched by the whole displacement from the touching position its side line needs more
+    friction than mu_s; left to settle, the side cap slips and sticks again, and the static
+    state with that slip is inside every strip's cone and kept still by the dynamics."""
+    slick = Cap(mu_s=0.05, mu_k=0.05)
+    side = BlockLine(block=Block(top=slick, bottom=slick, half_height=24 * 0.0254 + 0.15),
+                     n_blocks=2, offset=3.5, hull_height=0.3, hull_slope=0.3)
+    ship = Ship(mass=6e5, roll_inertia=6e5 * 9.0, g_height=3.0, keel_half_width=0.8,
+                half_beam=6.0, g_offset=0.3)
+    dock = DockSection(ship, BlockLine(n_blocks=4), (side,))
+    asm = assemble(dock)
+    init = rest_state(asm)
+    u = init.x[6 * asm.n_bodies:6 * asm.n_bodies + asm.n_strips]
+    demand = np.abs(asm.strip_f[:, K.SF_KT] * u)
+    loaded = init.normal > 0.0
+    assert np.all(demand[loaded] <= asm.strip_f[loaded, K.SF_MUS] * init.normal[loaded])
+    moved, events = _at_rest(dock)
+    assert moved < 1e-12 and events == ["start"]
+
+
+def test_a_dock_that_tips_when_left_to_settle_is_refused_saying_so():
+    """Campaign case 27 of seed 29 (one fixed side line): no static solution, and left under
+    gravity alone the ship tips off its supports: refused, the message saying both."""
+    dock, _, _ = random_case(29, 27)
+    with pytest.raises(NoStaticSolution, match=r"no static solution.*left under gravity alone "
+                                               r"from the stress-free position, it fails "
+                                               r"\(ship tips\) at t = \d"):
+        rest_state(assemble(dock))

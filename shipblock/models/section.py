@@ -74,7 +74,7 @@ import numpy as np
 from shipblock.errors import ParameterError, ShipblockError
 from shipblock.models.base import EDPInfo, Field, FieldError, Model
 from shipblock.section import NAVY_BLOCK, Block, BlockLine, Cap, DockSection, Ship, Wind
-from shipblock.section.model import assemble, static_state
+from shipblock.section.model import assemble
 from shipblock.section.parameters import (
     CAP_MATERIALS,
     DEFAULT_CAP_MATERIAL,
@@ -91,6 +91,7 @@ from shipblock.section.simulate import (
     DEFAULT_SEPARATION_HEIGHT,
     SectionResult,
     SectionRunner,
+    rest_state,
     simulate_section,
 )
 from shipblock.units import STANDARD_GRAVITY
@@ -601,7 +602,7 @@ class SectionModel(Model):
                 raise FieldError(name, f"missing: {f.doc} [{f.units}]")
         try:
             section = _section(table)
-            static_state(assemble(section))
+            rest_state(assemble(section))
         except FieldError:
             raise
         except ParameterError as exc:

@@ -71,8 +71,8 @@ from shipblock.errors import ParameterError
 from shipblock.section import _kernel as K
 from shipblock.section.parameters import DockSection
 
-__all__ = ["Assembly", "assemble", "damping_for_restitution", "impact_restitution", "lobatto",
-           "static_state"]
+__all__ = ["Assembly", "NoStaticSolution", "SlidesAtRest", "assemble", "damping_for_restitution",
+           "impact_restitution", "lobatto", "static_state", "sunk_state"]
 
 #: Largest rotation the model is written for [rad] (beyond it a run stops as out of validity).
 MAX_ANGLE = math.pi / 3.0
@@ -376,11 +376,13 @@ def _free(asm: Assembly) -> np.ndarray:
     return free
 
 
-def _residual(asm: Assembly):
+def _residual(asm: Assembly, slip: np.ndarray | None = None):
     """The static residual (generalised forces over the weight) of the free displacements from
-    ``asm.q0`` (scaled by ``_SCALE_Q``), and the map from those to the positions."""
+    ``asm.q0`` (scaled by ``_SCALE_Q``), and the map from those to the positions; each strip's
+    stick spring stretched by its tangential displacement from the touching position less its
+    ``slip`` (default none)."""
     free = _free(asm)
-    u0 = tangent_coordinates(asm, asm.q0)
+    u0 = tangent_coordinates(asm, asm.q0) + (0.0 if slip is None else slip)
     scale_f = asm.mass.sum() * asm.section.g
 
     def unpack(z):
@@ -428,6 +430,19 @@ def _sunk(asm: Assembly) -> np.ndarray:
     return sink
 
 
+def sunk_state(asm: Assembly) -> InitialState:
+    """The stress-free touching position with every body lowered by its supports' static
+    deflection, at rest, every loaded strip sticking: where :func:`static_state` starts, and
+    where :func:`shipblock.section.simulate.rest_state` lets the dock settle (not an
+    equilibrium)."""
+    free = _free(asm)
+    q = asm.q0.copy()
+    q[free] += _sunk(asm)[free]
+    x, _, reg, fs, normal, fn = _forces(asm, q, tangent_coordinates(asm, q)
+                                        - tangent_coordinates(asm, asm.q0))
+    return InitialState(x, reg, np.zeros(asm.spring_f.shape[0]), fs, normal, fn)
+
+
 def _by_continuation(asm: Assembly) -> tuple[np.ndarray, float]:
     """The static solution reached by opening the side lines' gaps (or interferences) from zero
     to their values in ``_GAP_STEPS`` steps, each solved from the last (Powell's method alone
@@ -448,36 +463,58 @@ def _by_continuation(asm: Assembly) -> tuple[np.ndarray, float]:
     return z, worst
 
 
-def static_state(asm: Assembly) -> InitialState:
+class NoStaticSolution(ParameterError):
+    """:func:`static_state` found no static solution."""
+
+
+class SlidesAtRest(ParameterError):
+    """:func:`static_state`'s solution needs more friction than a sticking strip's ``mu_s``."""
+
+
+def static_state(asm: Assembly, start: np.ndarray | None = None,
+                 slip: np.ndarray | None = None) -> InitialState:
     """The elastic static solution under gravity and steady wind, every loaded strip sticking.
 
     Solved by Powell's hybrid method (:func:`scipy.optimize.root`) on the generalised forces,
-    from the stress-free touching position.
+    from ``start`` (the bodies' positions, shape ``(3 n_bodies,)``), by default from the
+    stress-free touching position with every body lowered by its supports' static deflection
+    (and, failing that with a side line's gap, by continuation in the gaps). Each strip's stick
+    spring is stretched by its tangential displacement from the touching position, less its
+    ``slip`` (per strip [m]; default none: nothing slipped while the dock was landed).
+    :func:`shipblock.section.simulate.rest_state` tries again from where the dock comes to rest
+    under gravity alone, with what slipped on the way, when this finds nothing.
 
     Raises
     ------
+    NoStaticSolution
+        If it finds no static solution (a :class:`ParameterError`).
+    SlidesAtRest
+        If a sticking strip of the solution is outside its friction cone (naming the line).
     ParameterError
-        If there is no static solution (the ship is unstable on its supports at rest) or the caps
-        would crush under the static load (naming the line).
+        If the static state is unstable, or the caps would crush under the static load.
     """
     nb = asm.n_bodies
     free = _free(asm)
     scale_f = asm.mass.sum() * asm.section.g
-    residual, unpack = _residual(asm)
+    residual, unpack = _residual(asm, slip)
     # what rounding of the positions leaves unbalanced in the stiffest spring, times 100
     def floor(z):
         return 100 * np.finfo(float).eps * asm.spring_f[:, K.PF_K].max() * max(
             1.0, np.abs(unpack(z)).max()) * asm.spring_f.shape[0] / scale_f
 
-    z, worst = _solve(residual, _sunk(asm)[free] / _SCALE_Q)
-    if not worst < 1e-8 + floor(z) and any(asm.section.side_gap(i) != 0.0
-                                           for i in range(len(asm.section.sides))):
-        z, worst = _by_continuation(asm)
+    if start is None:
+        z, worst = _solve(residual, _sunk(asm)[free] / _SCALE_Q)
+        if not worst < 1e-8 + floor(z) and any(asm.section.side_gap(i) != 0.0
+                                               for i in range(len(asm.section.sides))):
+            z, worst = _by_continuation(asm)
+    else:
+        z, worst = _solve(residual, (np.asarray(start, dtype=float) - asm.q0)[free] / _SCALE_Q)
     q = unpack(z)
     x, gen, reg, fs, normal, fn = _forces(asm, q, tangent_coordinates(asm, q)
-                                          - tangent_coordinates(asm, asm.q0))
+                                          - tangent_coordinates(asm, asm.q0)
+                                          - (0.0 if slip is None else slip))
     if not (worst < 1e-8 + floor(z)):
-        raise ParameterError(
+        raise NoStaticSolution(
             f"the section has no static solution under gravity (largest unbalanced force "
             f"{worst:.2e} of the weight): the ship is not stable on its supports at rest; add side "
             "lines, widen the keel block or lower Ship.g_height")
@@ -515,7 +552,7 @@ def static_state(asm: Assembly) -> InitialState:
             li = int(asm.strip_line[j])
             key = "DockSection.keel" if li == 0 else f"DockSection.sides[{li - 1}]"
             face = "top" if asm.strip_top[j] else "bottom"
-            raise ParameterError(
+            raise SlidesAtRest(
                 f"{key}: at rest its {face} face needs a friction coefficient of "
                 f"{demand[j] / normal[j]:.3g}, above its mu_s "
                 f"({asm.strip_f[j, K.SF_MUS]:.3g}): the line would slide under the static load "
