@@ -80,6 +80,7 @@ def section_speed(repeats=5) -> dict:
         "accepted_steps": res.stats["accepted_steps"],
         "rejected_steps": res.stats["rejected_steps"],
         "exponential_steps": res.stats["exponential_steps"],
+        "settled_regimes": res.stats["settled_regimes"],
         "events": res.stats["events"],
         "section_dopri_seconds_per_run": min(dopri_times),
         "dopri_accepted_steps": dopri.stats["accepted_steps"],
