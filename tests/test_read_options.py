@@ -174,7 +174,7 @@ def test_a_read_option_of_another_format_is_refused_not_ignored(capsys, flag, va
     assert f"{key}={float(value)!r} applies to {readers} files only" in err
     assert "this file is SHIPBLOCK_AT2" in err and f"leave out {flag}, catalogue key {key}" in err
     shipped = Path(__file__).resolve().parents[1] / "records" / "south-napa-2014" / "NP.1737.mseed"
-    with pytest.raises(ParameterError, match=f"{key}=.* applies to .* this file is MSEED"):
+    with pytest.raises(RecordError, match=f"{key}=.* applies to .* this file is MSEED"):
         read_motion(str(shipped), **{key: float(value)})
 
 

@@ -286,7 +286,9 @@ def _check_trace(trace, name: str) -> None:
 
 def _check_format_keywords(stream, name: str, kwargs) -> None:
     """Refuse a format's own keyword (:data:`_FORMAT_KEYWORDS`) given for a file of a format
-    whose reader does not take it, naming the keyword and the formats that do."""
+    whose reader does not take it, naming the keyword and the formats that do (a
+    :class:`RecordError`, as a unit that contradicts the file's: the value is good, the file is
+    not one it suits)."""
     fmt = getattr(stream[0].stats, "_format", None)
     reader = FORMATS[fmt][1] if fmt in FORMATS else None
     takes = set(checks.keyword_names(reader, 1)) if reader is not None else set()
@@ -294,8 +296,8 @@ def _check_format_keywords(stream, name: str, kwargs) -> None:
         if kwargs.get(key) is None or key in takes:
             continue
         which = [f for f, (_, r) in FORMATS.items() if key in checks.keyword_names(r, 1)]
-        raise ParameterError(
-            f"{name}: {key}={kwargs[key]!r} applies to {' and '.join(which)} files only; this "
+        raise RecordError(
+            name, f"{key}={kwargs[key]!r} applies to {' and '.join(which)} files only; this "
             f"file is {fmt or 'of another format'}, whose reader does not use it (leave out "
             f"--{key.replace('_', '-')}, catalogue key {key}, Python {key}=)")
 
@@ -341,7 +343,9 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
         given: :mod:`shipblock.io.screen`), or it is corrupt or
         truncated: any libmseed diagnostic (a Steim integrity check, a record cut short),
         MiniSEED records that do not account for every byte of the file (a full SEED volume's
-        control headers count), a record whose plain encoding hides Steim frames; NaN/inf samples; a
+        control headers count), a record whose plain encoding hides Steim frames; a format's own
+        option (``dt``, ``resample_rate``, ``resample_interval``, ``data_type``) given for a file
+        whose reader does not take it; NaN/inf samples; a
         sampling interval outside 1e-4..1 s; a start time outside 1900-2200; samples in m/s^2
         above 100 g.
     """
