@@ -160,19 +160,23 @@ def test_caps_crushing_at_rest_are_refused_naming_the_line():
         static_state(assemble(sec))
 
 
-def test_a_side_line_that_would_slide_at_rest_is_refused():
-    """One side line under a sloped hull: the static state with the strips sticking from the
-    touching position needs more friction than mu_s gives; static_state refuses it naming the
-    line, not started out of its cone (rest_state then looks for the state the dock lands in:
-    test_a_side_line_that_slips_as_the_ship_lands_starts_from_where_it_stuck)."""
+def _slick_side_line():
+    """One side line of slick caps (mu 0.05) under a hull sloped 0.3, G off to starboard."""
     slick = Cap(mu_s=0.05, mu_k=0.05)
     side = BlockLine(block=Block(top=slick, bottom=slick, half_height=24 * 0.0254 + 0.15),
                      n_blocks=2, offset=3.5, hull_height=0.3, hull_slope=0.3)
     ship = Ship(mass=6e5, roll_inertia=6e5 * 9.0, g_height=3.0, keel_half_width=0.8,
                 half_beam=6.0, g_offset=0.3)
-    sec = DockSection(ship, BlockLine(n_blocks=4), (side,))
+    return DockSection(ship, BlockLine(n_blocks=4), (side,))
+
+
+def test_a_side_line_that_would_slide_at_rest_is_refused():
+    """One side line under a sloped hull: the static state with the strips sticking from the
+    touching position needs more friction than mu_s gives; static_state refuses it naming the
+    line, not started out of its cone (rest_state then looks for the state the dock lands in:
+    test_a_side_line_that_slips_as_the_ship_lands_starts_from_where_it_stuck)."""
     with pytest.raises(ParameterError, match=r"DockSection.sides\[0\]: at rest its .* face needs"):
-        static_state(assemble(sec))
+        static_state(assemble(_slick_side_line()))
 
 
 def test_side_lines_preloaded_by_an_interference_lift_the_ship_off_the_keel():
@@ -235,12 +239,7 @@ def test_a_side_line_that_slips_as_the_ship_lands_starts_from_where_it_stuck():
     stretched by the whole displacement from the touching position its side line needs more
     friction than mu_s; left to settle, the side cap slips and sticks again, and the static
     state with that slip is inside every strip's cone and kept still by the dynamics."""
-    slick = Cap(mu_s=0.05, mu_k=0.05)
-    side = BlockLine(block=Block(top=slick, bottom=slick, half_height=24 * 0.0254 + 0.15),
-                     n_blocks=2, offset=3.5, hull_height=0.3, hull_slope=0.3)
-    ship = Ship(mass=6e5, roll_inertia=6e5 * 9.0, g_height=3.0, keel_half_width=0.8,
-                half_beam=6.0, g_offset=0.3)
-    dock = DockSection(ship, BlockLine(n_blocks=4), (side,))
+    dock = _slick_side_line()
     asm = assemble(dock)
     init = rest_state(asm)
     u = init.x[6 * asm.n_bodies:6 * asm.n_bodies + asm.n_strips]
