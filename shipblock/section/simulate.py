@@ -34,7 +34,7 @@ DEFAULT_SEPARATION_HEIGHT = 0.02
 DEFAULT_MAX_EVENTS = 1_000_000
 #: exponential steps for a regime other than the static one are made once the dock has spent this
 #: long in it without an event [s], for at most this many regimes per run (session 20's
-#: measurement: docs/user_guide/section.rst, "Integrator")
+#: measurement: docs/theory/section.md, *Integrator*)
 SETTLE_SECONDS = 1.0
 SETTLED_REGIMES = 2
 #: How long :func:`rest_state` leaves a dock to settle under gravity alone [s], sampled at [s].
@@ -474,11 +474,12 @@ def rest_state(asm: Assembly) -> InitialState:
 
     Raises
     ------
-    NoStaticSolution
-        Where neither finds one: the message says what the dock did when left to settle
-        (the failure and its time, or that it came to rest only by slipping).
+    NoStaticSolution, SlidesAtRest
+        Where neither solve finds an admissible state (the first solve's error): the message
+        adds what the dock did when left to settle (the failure and its time, or that it came
+        to rest or was still moving, and why the solve from there failed).
     ParameterError
-        As :func:`~shipblock.section.model.static_state` (unstable, crushing, sliding at rest).
+        As :func:`~shipblock.section.model.static_state` (unstable, caps crushing at rest).
     """
     try:
         return static_state(asm)
