@@ -2,6 +2,8 @@
 the matrix functions and the energy integrals against brute-force quadrature, and whole runs
 against Dormand-Prince at tight tolerances (a second implementation of the same equations)."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 import scipy.integrate
@@ -142,8 +144,9 @@ def test_a_run_settled_after_strong_motion_goes_on_in_exponential_steps(navy, mo
     """0.3 g over 20 s: the last event at 18.6 s leaves caps open (not the static regime); one
     second later the run stops, makes the matrices of that regime and goes on in exponential
     steps. Up to the stop the run is bitwise the one without; after it, its histories, energy
-    terms and demand parameters agree with Dormand-Prince's from the same state."""
-    dock = navy[0]
+    terms and demand parameters agree with Dormand-Prince's from the same state. (Five springs
+    per cap, the dock this case was found on: with seven the caps close again.)"""
+    dock = dataclasses.replace(navy[0], n_springs=5)
     h, v, dt = record(duration=20.0, pga=0.3)
     res = simulate_section(dock, h, v, dt)
     monkeypatch.setattr(section_simulate, "SETTLED_REGIMES", 0)

@@ -78,6 +78,7 @@ from shipblock.section.model import assemble
 from shipblock.section.parameters import (
     CAP_MATERIALS,
     DEFAULT_CAP_MATERIAL,
+    DEFAULT_SPRINGS,
     MAX_BLOCKS,
     MAX_HULL_SLOPE,
     MAX_SIDE_LINES,
@@ -218,7 +219,7 @@ PARAMETERS: Mapping[str, Field] = MappingProxyType({f.name: f for f in (
              "the keel's underside", "m", "m", default_doc="required with wind"),
     # the model
     Field("n_springs", (int,), "springs across each cap (Gauss-Lobatto points)", "1",
-          default=5, low=SPRING_COUNTS[0], high=SPRING_COUNTS[1]),
+          default=DEFAULT_SPRINGS, low=SPRING_COUNTS[0], high=SPRING_COUNTS[1]),
     Field("g", _NUMBER, "acceleration of gravity", "m/s^2", default=STANDARD_GRAVITY,
           low=0.1, high=100.0),
 )})
