@@ -113,7 +113,14 @@ def kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
 
     ``pos[i] = (py, pz)`` is the world position of spring i's point on C (where its force acts).
     """
-    for j in range(strip_i.shape[0]):
+    strips_kinematics(x, nb, 0, strip_i.shape[0], strip_f, strip_i, spring_f, delta, delta_dot,
+                      vt, pos)
+
+
+@njit(cache=True, inline="always")
+def strips_kinematics(x, nb, j0, j1, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
+    """:func:`kinematics` of strips ``j0 .. j1 - 1`` (their springs' entries only)."""
+    for j in range(j0, j1):
         (cb, sb, ny, nz, a1, a2, d0, e0, w, l0, cy, cz, cc, cs, t0,
          p0) = _frame(x, nb, j, strip_f, strip_i)
         first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
@@ -169,7 +176,15 @@ def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, d
                    fe, fn, normal, tang):
     """Spring forces (total ``fn``, elastic ``fe``) and strip normal/tangential forces; the slip
     rate ``vt`` of a loaded strip moved to its centre of pressure (:func:`friction_offset`)."""
-    for j in range(strip_i.shape[0]):
+    strips_forces(x, o_u, nb, 0, strip_i.shape[0], strip_f, strip_i, spring_f, reg, dp, fs,
+                  delta, delta_dot, vt, fe, fn, normal, tang)
+
+
+@njit(cache=True, inline="always")
+def strips_forces(x, o_u, nb, j0, j1, strip_f, strip_i, spring_f, reg, dp, fs, delta, delta_dot,
+                  vt, fe, fn, normal, tang):
+    """:func:`contact_forces` of strips ``j0 .. j1 - 1`` (from their kinematics)."""
+    for j in range(j0, j1):
         first, count = strip_i[j, SI_FIRST], strip_i[j, SI_COUNT]
         total = 0.0
         f_delta = 0.0  # sum f delta: r . a = D0 - delta of every spring
@@ -447,3 +462,12 @@ def stage_rhs(t, x, nb, ns, mass, inertia, strip_f, strip_i, spring_f, fs, opt, 
         d_damp += dd
         d_fric += df
     _finish_rates(x, nb, ns, mass, inertia, opt, ay, az, d_damp, d_fric, xdot)
+
+
+@njit(cache=True, inline="always")
+def strip_of(i, strip_i):
+    """The strip spring i belongs to."""
+    for j in range(strip_i.shape[0]):
+        if strip_i[j, SI_FIRST] <= i < strip_i[j, SI_FIRST] + strip_i[j, SI_COUNT]:
+            return j
+    return -1

@@ -3,8 +3,9 @@
 The equations of motion and the contact laws are :mod:`shipblock.section._forces` (their
 layout constants and functions are re-exported here, the name callers use), the event
 functions and peaks :mod:`shipblock.section._events`, the exponential steps of the static
-regime :mod:`shipblock.section._static` (numba's cache of :func:`run` holds them compiled in:
-after editing one of those modules, touch this one).
+regime :mod:`shipblock.section._static` (numba's caches of :func:`run` and of the exponential
+step hold them compiled in, and numba checks only a module's own file: after editing
+``_forces`` or ``_events``, touch this module and ``_static``).
 
 Integrator: Dormand-Prince 5(4) with Hairer's 4th-order dense output; events (a spring
 closing, detaching, starting or ending to crush; a strip sticking, slipping; failures) are
@@ -28,8 +29,9 @@ from shipblock.section._forces import (  # the layout and laws, also for K.<name
     O_WIND_F, O_WIND_Y, O_WIND_Z, PF_AREA, PF_C, PF_FY, PF_K, PF_RY, PF_RZ, R_CRUSH, R_ELASTIC,
     R_FREE, SF_CT, SF_CY, SF_CZ, SF_KT, SF_MUK, SF_MUS, SF_PA, SF_PY, SF_PZ, SF_SNY, SF_SNZ,
     SF_SQY, SF_SQZ, SI_C, SI_COUNT, SI_FIRST, SI_S, cap_surface, contact_forces, kinematics,
-    regime_sums, rhs, stage_rhs)
-from shipblock.section._events import BIG, _event_values_of, _is_gap, _track, event_values
+    regime_sums, rhs, stage_rhs, strip_of)
+from shipblock.section._events import (BIG, _event_values_of, _is_gap, _track, event_value,
+                                      event_values)
 from shipblock.section._static import (STATIC_PAUSE, _in_static, _static_inside, _static_step,
                                        _vertex)
 
@@ -329,12 +331,12 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
                 if first >= 0:
                     # only look before the earliest one found so far
                     dense(r, hi, xe)
-                    event_values(t + hi * h, xe, nb, ns, strip_f, strip_i, spring_f, reg, dp,
-                                 dc0, tc0, fs, opt, delta, delta_dot, vt, pos, fe, fn, normal,
-                                 tang, theta_c, ge)
-                    if ge[q] > 0.0:
+                    gb = event_value(q, t + hi * h, xe, nb, ns, strip_f, strip_i, spring_f, reg,
+                                     dp, dc0, tc0, fs, opt, delta, delta_dot, vt, pos, fe, fn,
+                                     normal, tang, theta_c, ge)
+                    if gb > 0.0:
                         continue
-                    b, gb = hi, ge[q]
+                    b = hi
                 # Illinois (regula falsi with halving of the stale end's value)
                 side = 0
                 for _ in range(100):
@@ -345,10 +347,9 @@ def run(x, reg, dp, dc0, tc0, fs, nb, mass, inertia, strip_f, strip_i, spring_f,
                     if not (a + 0.01 * (b - a) < mid < b - 0.01 * (b - a)):
                         mid = min(max(mid, a + 0.01 * (b - a)), b - 0.01 * (b - a))
                     dense(r, mid, xe)
-                    event_values(t + mid * h, xe, nb, ns, strip_f, strip_i, spring_f, reg, dp,
-                                 dc0, tc0, fs, opt, delta, delta_dot, vt, pos, fe, fn, normal,
-                                 tang, theta_c, ge)
-                    gm = ge[q]
+                    gm = event_value(q, t + mid * h, xe, nb, ns, strip_f, strip_i, spring_f,
+                                     reg, dp, dc0, tc0, fs, opt, delta, delta_dot, vt, pos, fe,
+                                     fn, normal, tang, theta_c, ge)
                     if gm > 0.0:
                         a, ga = mid, gm
                         if side == 1:
@@ -546,7 +547,7 @@ def _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, 
     if q < 2 * nsp:
         i = q // 2
         k, c, fy = spring_f[i, PF_K], spring_f[i, PF_C], spring_f[i, PF_FY]
-        j = _strip_of(i, strip_i)
+        j = strip_of(i, strip_i)
         if reg[i] == R_FREE:
             # the body meets the (relaxing) cap: elastic energy of the cap carries on
             rem = cap_surface(k, c, dp[i], dc0[i], tc0[i], t) - dp[i]
@@ -612,13 +613,3 @@ def _transition(q, t, x, nb, ns, nsp, strip_f, strip_i, spring_f, reg, dp, dc0, 
         return EV_OVERTURN, q - o + 1
     kinds = (EV_SLID_OFF, EV_TIP, EV_SEPARATION, EV_INVALID)
     return kinds[q - o - nb + 1], -1
-
-
-@njit(cache=True, inline="always")
-def _strip_of(i, strip_i):
-    for j in range(strip_i.shape[0]):
-        if strip_i[j, SI_FIRST] <= i < strip_i[j, SI_FIRST] + strip_i[j, SI_COUNT]:
-            return j
-    return -1
-
-
