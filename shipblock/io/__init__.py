@@ -58,6 +58,7 @@ from shipblock.io._common import (
     check_plausible_samples,
     check_sampling_interval,
     check_start_time,
+    code_from_name,
     peek_text,
     sensitivity_sign,
 )
@@ -75,6 +76,7 @@ __all__ = [
     "check_reader_keywords",
     "check_plausible_samples",
     "check_sampling_interval",
+    "code_from_name",
     "known_formats",
     "read_record",
     "reader_keywords",

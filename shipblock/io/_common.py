@@ -569,6 +569,24 @@ def make_trace(data, delta: float, stats: dict) -> Trace:
 CARDINAL_TOLERANCE_DEG = 1.0
 
 
+def code_from_name(text: str) -> str:
+    """A code made of a name: each run of anything but letters, digits and ``_`` becomes one
+    ``-``, none at either end.
+
+    For a station a file names in words only (PEER AT2) and for record ids: such a code holds no
+    ``.`` (the separator of a SEED id ``NET.STA.LOC.CHA``), no space and nothing a file name
+    would have to quote, and different names stay different.
+
+    Examples
+    --------
+    >>> code_from_name("Anaheim - Lakeview & Riverdale")
+    'Anaheim-Lakeview-Riverdale'
+    >>> code_from_name("Mt. Wilson - CIT Seis Sta")
+    'Mt-Wilson-CIT-Seis-Sta'
+    """
+    return re.sub(r"[^A-Za-z0-9_]+", "-", text).strip("-")
+
+
 def band_code(sampling_rate: float) -> str:
     """SEED band code of an accelerometer channel for its sampling rate [Hz].
 
