@@ -47,8 +47,8 @@ Line 2 names the station in words and no network or location, so the trace's SEE
   follows their azimuths (rule 3 of :data:`shipblock.records.sensors.HORIZONTAL_RULE`: PEER
   ``000``/``090`` -> ``000``, ``045``/``315`` -> ``315``), not their codes' digits.
 
-Until shipblock 0.1.0 these were the raw words (``.Corralitos..0``: the station name as the
-code, the component word as the channel).
+Earlier the id held the raw words (``.Corralitos..0``: the station name as the code, the
+component word as the channel).
 
 References
 ----------
