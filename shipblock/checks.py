@@ -64,6 +64,7 @@ __all__ = [
     "existing_file",
     "flag",
     "closest",
+    "how_to_leave_out",
     "how_to_pass",
     "is_real",
     "keyword_names",
@@ -509,16 +510,37 @@ def how_to_pass(keyword: str, value, placeholder: bool = False) -> str:
     """
     flag, key = READ_OPTIONS[keyword]
     if keyword == "channel_map":
-        return (f"pass --channel-map CHANNEL=H1 (CHANNEL a channel code, SEED id or file name;"
-                f" one per channel, H1, H2 or V, comma-separated or repeated;"
-                f" catalogue table [record.components] with CHANNEL = \"H1\"; Python"
-                f" channel_map={{'CHANNEL': 'H1', ...}})")
+        return ("pass --channel-map CHANNEL=H1 (CHANNEL a channel code, SEED id or file name;"
+                " one per channel, H1, H2 or V, comma-separated or repeated;"
+                " catalogue table [record.components] with CHANNEL = \"H1\"; Python"
+                " channel_map={'CHANNEL': 'H1', ...})")
     if value is True:
         return f"pass {flag} (catalogue key {key} = true; Python {keyword}=True)"
     if placeholder:
         return f"pass {flag} {value} (catalogue key {key} = {value}; Python {keyword}={value})"
     toml = f'"{value}"' if isinstance(value, str) else f"{value!r}"
     return f"pass {flag} {value} (catalogue key {key} = {toml}; Python {keyword}={value!r})"
+
+
+def how_to_leave_out(keyword: str) -> str:
+    """How to stop giving a read option, in the three places it can be given.
+
+    Parameters
+    ----------
+    keyword : str
+        A key of :data:`READ_OPTIONS` (the Python keyword).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> how_to_leave_out("resample_rate")
+    'leave out --resample-rate, catalogue key resample_rate, Python resample_rate='
+    """
+    flag, key = READ_OPTIONS[keyword]
+    return f"leave out {flag}, catalogue key {key}, Python {keyword}="
 def label(value, name: str, *, what: str = "a name") -> str:
     """``value`` checked to be a non-empty string of printable characters.
 

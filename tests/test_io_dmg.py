@@ -133,7 +133,7 @@ def test_time_value_pairs_in_tenths_of_g():
     east = stream[0]
     header = east.stats.shipblock_dmg
     assert east.stats.original_units == "g/10"
-    assert header.time_value_pairs and header.original_npts == 12080
+    assert header.time_value_pairs and header.interpolated and header.original_npts == 12080
     assert east.stats.npts == 12000 and east.stats.delta == 0.005
     # The largest pair value is -.549 (g/10) at 15.992 s; the header says MAX = -.055 G.
     assert np.max(np.abs(east.data)) == pytest.approx(0.0549 * STANDARD_GRAVITY, rel=0.01)
@@ -144,6 +144,19 @@ def test_time_value_pairs_in_tenths_of_g():
     # A finer grid on request.
     fine = read_dmg(corpus_file("dmg/ci3031425/NEWPORT.RAW"), resample_interval=0.0025)
     assert fine[0].stats.npts == 23999 + 1 and fine[0].stats.delta == 0.0025
+
+
+@pytest.mark.parametrize(("relpath", "stored"), [("dmg/nc71734741/CE89146.V2", "0.005 s"),
+                                                 ("dmg/ci15481673/CIWLT.RAW", "0.01 s"),
+                                                 ("dmg/ci15481673/CIWLT.V2", "0.02 s")])
+def test_resample_interval_refused_for_an_even_file(relpath, stored):
+    """resample_interval sets the grid of uneven time/value pairs only (NEWPORT.RAW above); a
+    file with none is read as stored, so the option is refused naming it, not ignored."""
+    with pytest.raises(RecordError, match=rf"resample_interval=0\.01 cannot apply: the record is"
+                                          rf" evenly sampled at {stored} intervals"):
+        read_dmg(corpus_file(relpath), resample_interval=0.01)
+    stream = read_dmg(corpus_file(relpath))
+    assert not any(trace.stats.shipblock_dmg.interpolated for trace in stream)
 
 
 def test_h1_h2_horizontals_gmprocess_refuses():

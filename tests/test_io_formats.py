@@ -40,7 +40,9 @@ def test_at2_values_in_si_and_header():
     assert tr.stats.units == "m/s**2"
     assert tr.stats.original_units == "g"
     assert tr.stats.azimuth == 180.0 and tr.stats.dip == 0.0
-    assert tr.stats.station == "Carroll College"
+    assert tr.id == ".CARROLL-COLLEGE..HN1"  # 180 deg: nearer north-south, not north
+    assert tr.stats.shipblock_at2.station_name == "Carroll College"
+    assert tr.stats.file_component == "180"
     assert tr.stats.shipblock_at2.event == "Helena Montana-01"
 
 

@@ -18,6 +18,7 @@ from obspy import UTCDateTime
 from shipblock import read_motion
 from shipblock.errors import UnitsError
 from shipblock.io import read_record
+from shipblock.records.folders import read_motions as read_motion_set
 from tests.real_corpus import outside_file
 
 pytestmark = pytest.mark.filterwarnings("ignore")
@@ -149,6 +150,75 @@ def _at2_samples(path) -> np.ndarray:
     """The samples of an AT2 file [g], parsed here (5 per line after the 4 header lines)."""
     lines = path.read_text().splitlines()[4:]
     return np.array([float(v) for line in lines for v in line.split()])
+
+
+BREA = ["pyrotd/RSN8884_14383980_13873090.AT2", "pyrotd/RSN8884_14383980_13873360.AT2"]
+LOMA = "loma/RSN753_LOMAP_CLS000.AT2"
+G = 9.80665
+
+
+def test_peer_ids_name_station_and_component():
+    """A PEER file states its station in words and its component as a word (``Corralitos, 0``):
+    the id is ``.STATION..CHANNEL`` with the name made an upper-case code and the component
+    an orientation code (it was ``.Corralitos..0``); the azimuth and the word are kept."""
+    expected = {LOMA: (".CORRALITOS..HNN", 0.0, "0", "Corralitos"),
+                ANAHEIM[0]: (".ANAHEIM-LAKEVIEW-RIVERDALE..HNE", 90.0, "90",
+                             "Anaheim - Lakeview & Riverdale"),
+                ANAHEIM[1]: (".ANAHEIM-LAKEVIEW-RIVERDALE..HNN", 0.0, "360",
+                             "Anaheim - Lakeview & Riverdale"),
+                BREA[0]: (".BREA-CENTRAL-AVE-CALTRANS-YARD..HNE", 90.0, "90",
+                          "Brea - Central Ave Caltrans Yard"),
+                BREA[1]: (".BREA-CENTRAL-AVE-CALTRANS-YARD..HNN", 0.0, "360",
+                          "Brea - Central Ave Caltrans Yard")}
+    for rel, (trace_id, azimuth, word, name) in expected.items():
+        trace = read_record(outside_file(rel))[0]
+        assert trace.id == trace_id, rel
+        assert (trace.stats.azimuth, trace.stats.dip) == (azimuth, 0.0)
+        assert trace.stats.file_component == word
+        assert trace.stats.shipblock_at2.station_name == name
+
+
+def test_peer_folder_pairs_each_stations_horizontals():
+    """Read together, the files of two stations and a single one make three records; each pair
+    is one record with H1 the 360 file (azimuth 0) and H2 the 090 file, as before the ids
+    changed (a map by the file's component words still works)."""
+    paths = [outside_file(rel) for rel in [LOMA, *ANAHEIM, *BREA]]
+    found = read_motion_set(paths)
+    assert sorted(m.name for m in found) == ["ANAHEIM-LAKEVIEW-RIVERDALE",
+                                             "BREA-CENTRAL-AVE-CALTRANS-YARD", "CORRALITOS"]
+    for motion in found:
+        if motion.name == "CORRALITOS":
+            assert set(motion.components) == {"H1"}
+            continue
+        station = motion.name
+        assert motion.metadata["channels"] == {"H1": f".{station}..HNN", "H2": f".{station}..HNE"}
+        assert motion.azimuths == {"H1": 0.0, "H2": 90.0}
+        files = ANAHEIM if station.startswith("ANAHEIM") else BREA
+        np.testing.assert_allclose(motion.components["H1"], _at2_samples(outside_file(files[1])) * G,
+                                   rtol=1e-6, atol=1e-12)
+    swapped = read_motion([outside_file(rel) for rel in ANAHEIM],
+                          channel_map={"90": "H1", "360": "H2"})
+    np.testing.assert_allclose(swapped.components["H1"],
+                               _at2_samples(outside_file(ANAHEIM[0])) * G, rtol=1e-6, atol=1e-12)
+
+
+def test_peer_diagonal_pair_and_dotted_station_name(tmp_path):
+    """Components 045 and 315 get HN1 and HN2 by their nearer axes, but H1 stays the one the
+    other is 90 deg clockwise from (315), as for every PEER pair; a station name with a dot
+    (``Mt. Wilson``) gives a code without one, so the id still has four parts."""
+    files = []
+    for rel, word in zip(ANAHEIM, ("045", "315"), strict=True):
+        text = outside_file(rel).read_text()
+        text = text.replace("Anaheim - Lakeview & Riverdale, ", "Mt. Wilson - CIT Seis Sta, ", 1)
+        files.append(tmp_path / f"{word}.AT2")
+        files[-1].write_text(re.sub(r", (90|360)\n", f", {word}\n", text, count=1))
+    traces = [read_record(f)[0] for f in files]
+    assert [tr.id for tr in traces] == [".MT-WILSON-CIT-SEIS-STA..HN1", ".MT-WILSON-CIT-SEIS-STA..HN2"]
+    assert len(traces[0].id.split(".")) == 4
+    motion = read_motion(files)
+    assert motion.azimuths == {"H1": 315.0, "H2": 45.0}
+    np.testing.assert_allclose(motion.components["H1"], _at2_samples(files[1]) * G, rtol=1e-6,
+                               atol=1e-12)
 
 
 @pytest.mark.parametrize(("word", "up"), [("DWN", False), ("DOWN", False), ("UP", True),

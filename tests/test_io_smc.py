@@ -19,6 +19,7 @@ import pytest
 from obspy import UTCDateTime
 
 from shipblock.errors import RecordError, UnitsError
+from shipblock.io import read_record
 from shipblock.io.smc import is_smc, read_smc
 from tests.reader_fuzz import assert_reader_survives
 from tests.real_corpus import (
@@ -156,6 +157,25 @@ def test_resample_rate_option_and_headonly():
     full = read_smc(corpus_file(relpath))[0]
     assert head.stats.npts == full.stats.npts and head.data.size == 0
     assert (read_smc(io.BytesIO(_raw(relpath)))[0].data == full.data).all()
+
+
+@pytest.mark.parametrize("relpath", [f for f in FILES if STATED[f.rsplit("/", 1)[1]][3] is None])
+def test_resample_rate_refused_for_an_even_file(relpath):
+    """0111a/b/c.smc are evenly sampled at 200 samples/s: resample_rate, which only sets the grid
+    of (time, value) pairs, would leave them as stored, so it is refused naming the option and
+    the file (it was accepted and ignored, the user believing the record resampled). Without
+    it they read at their own rate, and the option still applies to a pair file."""
+    path = corpus_file(relpath)
+    with pytest.raises(RecordError) as caught:
+        read_record(path, resample_rate=100.0)
+    message = str(caught.value)
+    assert message.startswith(f"{path}: resample_rate=100.0 cannot apply")
+    assert "evenly sampled at 200 samples/s" in message
+    assert "leave out --resample-rate, catalogue key resample_rate" in message
+    assert read_smc(path)[0].stats.sampling_rate == 200.0
+    pairs = read_record(corpus_file(DIR + "891018_1.sma-1.0444a.smc"), resample_rate=100.0)[0]
+    assert pairs.stats.sampling_rate == 100.0
+    assert pairs.stats.shipblock_smc.resample_rate_hz == 100.0
 
 
 def test_detection():

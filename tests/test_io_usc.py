@@ -149,6 +149,16 @@ def test_file_object_headonly_and_resample_rate():
         fine.stats.shipblock_usc.digitized_peak_si, rel=1e-12)
 
 
+def test_resample_rate_refused_for_a_volume_ii_file():
+    """017m30bt.s0a is a Volume II, evenly sampled at 0.02 s: resample_rate (the grid of Volume
+    I's digitized points) would leave it as stored, so it is refused, not ignored."""
+    path = corpus_file(DIR + "017m30bt.s0a")
+    with pytest.raises(RecordError, match=r"017m30bt\.s0a: resample_rate=100\.0 cannot apply: the"
+                                          r" record is a Volume II, evenly sampled at 50 samples/s"):
+        read_usc(path, resample_rate=100.0)
+    assert read_usc(path)[0].stats.delta == 0.02
+
+
 def test_concatenated_channels():
     """Channels may follow each other in one file (blank lines between are allowed)."""
     raw = _raw(DIR + "017m30lw.e0a") + _raw(DIR + "017m30lw.e0b") + _raw(DIR + "017m30lw.e0c")

@@ -250,7 +250,7 @@ def test_v2_default_horizontal_is_the_files_first_and_info_shows_raw_and_process
 def test_catalogue_ids_of_peer_files_are_clean(tmp_path):
     found = read_motions([str(LOMA), *map(str, PAIR)])
     ids = sorted(record_id(m) for m in found)
-    assert ids == ["Anaheim-Lakeview-Riverdale.360-90", "Corralitos.0"]
+    assert ids == ["ANAHEIM-LAKEVIEW-RIVERDALE.HN", "CORRALITOS.HN"]
     assert record_file_stem(".Anaheim - Lakeview & Riverdale..36") == (
         "Anaheim_-_Lakeview_Riverdale..36")
     assert record_file_stem("south-napa-2014/NP.1765..HN") == "south-napa-2014_NP.1765..HN"
@@ -260,13 +260,13 @@ def test_catalogue_ids_of_peer_files_are_clean(tmp_path):
 @needs_outside
 def test_require_components_names_record_and_key():
     loma = read_motion(str(LOMA))
-    with pytest.raises(RecordError, match=r'Corralitos.0: has no vertical \(V\); it holds H1,'
+    with pytest.raises(RecordError, match=r'CORRALITOS.HN: has no vertical \(V\); it holds H1,'
                                           r' but vertical = "same" needs it'):
-        require_components(loma, ("H1", "V"), record="Corralitos.0", key='vertical = "same"')
+        require_components(loma, ("H1", "V"), record="CORRALITOS.HN", key='vertical = "same"')
     require_components(read_motion(str(V2)), ("H1", "V"), record="CE.89486..HN",
                        key='vertical = "same"')
     with pytest.raises(ParameterError, match="components"):
-        require_components(loma, ("X",), record="Corralitos.0", key="k")
+        require_components(loma, ("X",), record="CORRALITOS.HN", key="k")
 
 
 # ------------------------------------------------------------------ every option in three places

@@ -48,17 +48,17 @@ from obspy.core.util.base import ENTRY_POINTS
 
 from shipblock import checks
 from shipblock.errors import ParameterError, ParameterTypeError, RecordError, ShipblockError
-from shipblock.io import at2, bhrc, cosmos, cwb, dmg, esm, geonet, nsmn, renadic, smc, text, unam, usc
+from shipblock.io import at2, bhrc, cosmos, cwb, dmg, esm, geonet, nsmn, renadic, screen, smc, text, unam, usc
 from shipblock.io import mseed as mseed_checks
-from shipblock.io import screen
 from shipblock.io._common import (
     MAX_DIGITIZATION_GAP_S,
-    PolarityReversalWarning,
     UNITS_GIVEN_KEY,
+    PolarityReversalWarning,
     check_count_value,
     check_plausible_samples,
     check_sampling_interval,
     check_start_time,
+    code_from_name,
     peek_text,
     sensitivity_sign,
 )
@@ -76,6 +76,7 @@ __all__ = [
     "check_reader_keywords",
     "check_plausible_samples",
     "check_sampling_interval",
+    "code_from_name",
     "known_formats",
     "read_record",
     "reader_keywords",
@@ -298,8 +299,8 @@ def _check_format_keywords(stream, name: str, kwargs) -> None:
         which = [f for f, (_, r) in FORMATS.items() if key in checks.keyword_names(r, 1)]
         raise RecordError(
             name, f"{key}={kwargs[key]!r} applies to {' and '.join(which)} files only; this "
-            f"file is {fmt or 'of another format'}, whose reader does not use it (leave out "
-            f"--{key.replace('_', '-')}, catalogue key {key}, Python {key}=)")
+            f"file is {fmt or 'of another format'}, whose reader does not use it"
+            f" ({checks.how_to_leave_out(key)})")
 
 
 def read_record(path, format: str | None = None, units: str | None = None, **kwargs):
@@ -319,7 +320,8 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
         Passed to the reader: ``dt`` [s] for a one-column text file, ``data_type``
         (``"acceleration"``) for an SMC file whose header says ``0 UNKNOWN``, ``resample_rate`` [Hz] for
         SMC and USC files, ``resample_interval`` [s] for DMG files (each checked: an interval
-        within 1e-4..1 s, a rate within 1..1e4 Hz), or obspy's own keywords (those of
+        within 1e-4..1 s, a rate within 1..1e4 Hz; the grid of a record digitized at uneven
+        times, refused for an evenly sampled file, which it would leave as stored), or obspy's own keywords (those of
         :func:`obspy.read` and of its format readers; any other is refused, see
         :func:`check_reader_keywords`).
 
@@ -345,7 +347,8 @@ def read_record(path, format: str | None = None, units: str | None = None, **kwa
         MiniSEED records that do not account for every byte of the file (a full SEED volume's
         control headers count), a record whose plain encoding hides Steim frames; a format's own
         option (``dt``, ``resample_rate``, ``resample_interval``, ``data_type``) given for a file
-        whose reader does not take it; NaN/inf samples; a
+        whose reader does not take it, or ``resample_rate``/``resample_interval`` given for an
+        evenly sampled file; NaN/inf samples; a
         sampling interval outside 1e-4..1 s; a start time outside 1900-2200; samples in m/s^2
         above 100 g.
     """

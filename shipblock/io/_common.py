@@ -16,7 +16,7 @@ import warnings
 import numpy as np
 from obspy import Trace, UTCDateTime
 
-from shipblock.checks import MAX_ACCELERATION, MAX_TIME_STEP, MIN_TIME_STEP
+from shipblock.checks import MAX_ACCELERATION, MAX_TIME_STEP, MIN_TIME_STEP, how_to_leave_out
 from shipblock.errors import RecordError
 
 #: Number of bytes read by the format-detection functions [bytes].
@@ -503,6 +503,44 @@ def resample_pairs(times, values, rate_hz: float, name: str):
     return np.interp(grid, unique, values), float(unique[0]), merged
 
 
+def check_resampling_applies(name: str, keyword: str, value, uneven: bool, stored: str) -> None:
+    """Refuse a resampling read option given for a file that holds no uneven samples.
+
+    ``resample_rate`` (SMC, USC) and ``resample_interval`` (DMG) set the even grid onto which
+    unevenly digitized (time, value) pairs are interpolated, as gmprocess's read option
+    ``resample_rate`` does (its readers interpolate only the samples that are not evenly spaced).
+    A record sampled evenly as stored is returned as stored: resampling it needs an anti-alias
+    filter, which is a processing step, not a reader's. Given for such a file the option would
+    have no effect and the caller would believe the record resampled, so it is refused.
+
+    Parameters
+    ----------
+    name : str
+        The file, for the message.
+    keyword : str
+        The option (a key of :data:`shipblock.checks.READ_OPTIONS`).
+    value : float or None
+        Its value; ``None`` (not given) is always accepted.
+    uneven : bool
+        Whether the file held uneven pairs, interpolated at ``value``.
+    stored : str
+        How the file is sampled, for the message (``"evenly sampled at 200 samples/s"``).
+
+    Raises
+    ------
+    RecordError
+        Naming the file, the option, why it does not apply and how to resample instead.
+    """
+    if value is None or uneven:
+        return
+    raise RecordError(
+        name, f"{keyword}={value!r} cannot apply: the record is {stored} as stored, with no"
+        f" unevenly digitized (time, value) pairs, and {keyword} only sets the grid such pairs"
+        f" are interpolated onto (the samples would be returned unchanged). To change an even"
+        f" record's rate use the anti-aliased processing step 'resample' (or align='resample'"
+        f" across components); {how_to_leave_out(keyword)}")
+
+
 def make_trace(data, delta: float, stats: dict) -> Trace:
     """Build an obspy Trace of float64 samples.
 
@@ -529,6 +567,24 @@ def make_trace(data, delta: float, stats: dict) -> Trace:
 
 #: Largest departure from north or east [deg] for which a horizontal is named N or E.
 CARDINAL_TOLERANCE_DEG = 1.0
+
+
+def code_from_name(text: str) -> str:
+    """A code made of a name: each run of anything but letters, digits and ``_`` becomes one
+    ``-``, none at either end.
+
+    For a station a file names in words only (PEER AT2) and for record ids: such a code holds no
+    ``.`` (the separator of a SEED id ``NET.STA.LOC.CHA``), no space and nothing a file name
+    would have to quote, and different names stay different.
+
+    Examples
+    --------
+    >>> code_from_name("Anaheim - Lakeview & Riverdale")
+    'Anaheim-Lakeview-Riverdale'
+    >>> code_from_name("Mt. Wilson - CIT Seis Sta")
+    'Mt-Wilson-CIT-Seis-Sta'
+    """
+    return re.sub(r"[^A-Za-z0-9_]+", "-", text).strip("-")
 
 
 def band_code(sampling_rate: float) -> str:

@@ -23,9 +23,32 @@ within 1e-4..1 s (``DT= 1,5``, a decimal comma, is refused, not read as 1 s) and
 value cut short (``-.1234567E-0``, 100 times too large) is refused. The component token of line 2
 gives the orientation: a number is the azimuth [deg clockwise from north];
 ``UP``/``V``/``VER``/``Z`` is vertical positive up and ``DWN``/``DOWN`` vertical positive down. The
-component word is the channel code (``stats.seed_channel`` is ``False``: it names no SEED sensor,
-so a ``DWN`` vertical stays with the ``164``/``254`` horizontals of its station). The file holds no
-start time, so traces start at the epoch (1970-01-01T00:00:00Z).
+file holds no start time, so traces start at the epoch (1970-01-01T00:00:00Z).
+
+Line 2 names the station in words and no network or location, so the trace's SEED-like id
+``NET.STA.LOC.CHA`` is made as follows (``Loma Prieta, 10/18/1989, Corralitos, 0`` gives
+``.CORRALITOS..HNN``):
+
+* network and location: empty (PEER states none; obspy's default);
+* station: the station name in upper case (as SEED codes are written, and so that files that
+  write it in different cases are one station) with each run of characters other than letters,
+  digits and ``_`` made one ``-`` (``Anaheim - Lakeview & Riverdale`` ->
+  ``ANAHEIM-LAKEVIEW-RIVERDALE``): no ``.`` to break the id, no space, and two stations stay
+  two. The name as written is ``stats.shipblock_at2.station_name``;
+* channel: the orientation code every shipblock reader gives an accelerometer component (band
+  letter by rate, ``N``, then ``Z`` vertical, ``N``/``E`` for a horizontal along north/east, else
+  ``1``/``2`` by the nearer axis): ``000`` and ``360`` -> ``HNN``, ``090`` -> ``HNE``, ``180`` ->
+  ``HN1``, ``270`` -> ``HN2``, ``UP`` and ``DWN`` -> ``HNZ`` (``stats.dip`` -90 or 90 tells the
+  polarity). ``stats.azimuth`` keeps the azimuth and ``stats.file_component`` the word as the
+  file writes it (``"0"``, ``"DWN"``), which a ``channel_map`` may also name. A word that states
+  no orientation (``FN``) is kept as the channel, its component left to a ``channel_map``;
+* ``stats.seed_channel`` is ``False``: the code is the reader's, not an agency's, and names no
+  sensor, so the files of one station are one record, and the H1/H2 order of two horizontals
+  follows their azimuths (rule 3 of :data:`shipblock.records.sensors.HORIZONTAL_RULE`: PEER
+  ``000``/``090`` -> ``000``, ``045``/``315`` -> ``315``), not their codes' digits.
+
+Earlier the id held the raw words (``.Corralitos..0``: the station name as the code, the
+component word as the channel).
 
 References
 ----------
@@ -47,7 +70,10 @@ from shipblock.io._common import (
     check_plausible_samples,
     check_samples,
     check_sampling_interval,
+    code_from_name,
+    horizontal_index,
     make_trace,
+    orientation_stats,
     parse_float,
     peek_text,
     read_text,
@@ -190,19 +216,29 @@ def is_at2(filename) -> bool:
         return False
 
 
-def _orientation(component: str) -> dict:
-    """Map the component token of header line 2 to ``azimuth``/``dip`` [deg] entries."""
+def _orientation(component: str, sampling_rate: float) -> dict:
+    """Map the component token of header line 2 to ``channel``, ``azimuth``/``dip`` [deg].
+
+    A known orientation gets the SEED-like code of every shipblock reader
+    (:func:`~shipblock.io._common.orientation_stats`: ``HNZ``, ``HNN``, ``HNE``, ``HN1``/``HN2``,
+    band letter by rate); an unknown token is kept as the channel (letters, digits, ``-``), its
+    orientation left unset (a ``channel_map`` names its component).
+    """
     token = component.strip().upper()
     if token in _VERTICAL_UP or token.endswith("-UP"):
-        return {"dip": -90.0}
+        return orientation_stats(sampling_rate, vertical=True, positive_up=True)
     if token in _VERTICAL_DOWN or token.endswith("-DWN"):
-        return {"dip": 90.0}
+        return orientation_stats(sampling_rate, vertical=True, positive_up=False)
+    azimuth = None
     digits = re.search(r"(\d{1,3})$", token)
     if digits is not None and 0 <= int(digits.group(1)) <= 360:
-        return {"azimuth": float(int(digits.group(1)) % 360), "dip": 0.0}
-    if len(token) == 3 and token[2] in "NE":
-        return {"azimuth": 0.0 if token[2] == "N" else 90.0, "dip": 0.0}
-    return {}
+        azimuth = float(int(digits.group(1)) % 360)
+    elif len(token) == 3 and token[2] in "NE":
+        azimuth = 0.0 if token[2] == "N" else 90.0
+    if azimuth is None:
+        return {"channel": code_from_name(component)}
+    return orientation_stats(sampling_rate, vertical=False, azimuth_deg=azimuth,
+                             index=horizontal_index(azimuth))
 
 
 def _normalise(word: str) -> str:
@@ -284,6 +320,8 @@ def read_at2(filename, headonly: bool = False, **kwargs) -> Stream:
     -------
     obspy.Stream
         One trace; ``stats.units == "m/s**2"``, ``stats.original_units`` the header unit,
+        station and channel codes made from the header (see the module's notes: e.g.
+        ``.CORRALITOS..HNN``), ``stats.file_component`` the component word as written,
         ``stats.azimuth``/``stats.dip`` [deg] where the component token tells them, and the
         original header in ``stats.shipblock_at2``.
 
@@ -334,15 +372,20 @@ def read_at2(filename, headonly: bool = False, **kwargs) -> Stream:
         }
     )
     stats = {
-        "station": station,
-        "channel": component,
-        # The component word of the file (``"164"``, ``"DWN"``), not a SEED code: ``DWN`` is no
-        # sensor ``DW`` apart from the horizontals of the same station.
+        # PEER states no network, station code or location: the station is the name of line 2
+        # made an upper-case code (no dots or spaces: "Mt. Wilson" is no NET.STA split), the
+        # channel is made from the component word, which is kept in file_component.
+        "network": "",
+        "station": code_from_name(station).upper(),
+        "location": "",
+        "file_component": component,
+        # The channel code is the reader's, not the agency's: it names no sensor, so the three
+        # files of a station stay one record whatever their rates.
         "seed_channel": False,
         "units": "m/s**2",
         "original_units": unit,
         "shipblock_at2": header,
-        **_orientation(component),
+        **_orientation(component, 1.0 / delta),
     }
     if headonly:
         trace = make_trace([], delta, stats)

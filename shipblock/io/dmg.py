@@ -54,7 +54,10 @@ What the real files (USGS gmprocess test corpus) showed that a format descriptio
 * the time/value pairs of digitised records are printed to 0.001 s around a nominal 0.005 s, so
   their steps are 0.004, 0.005 and 0.006 s: they are interpolated linearly onto an even grid whose
   step is their median step (0.005 s; ``resample_interval`` overrides it), from the first time to
-  the last. The original count is kept in the header (``original_npts``);
+  the last. The original count is kept in the header (``original_npts``), and ``interpolated``
+  says whether a channel was. ``resample_interval`` given for a file with no uneven channel (a
+  V2, or pairs already evenly spaced) is refused (:class:`RecordError`): it would have no
+  effect;
 * the digit count of the data format changes between channels of one file (``8f10.6`` and
   ``8f10.5`` in CIWLT.V2) to make room for larger values, and some files omit the format: it is
   then inferred from the width of the first data line;
@@ -100,6 +103,7 @@ from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
     FLOAT_RE,
     check_plausible_samples,
+    check_resampling_applies,
     check_samples,
     check_sampling_interval,
     horizontal_index,
@@ -425,6 +429,7 @@ def _read_channel(volume, start, block, has_marker, name, headonly, resample_int
 
     offset = 0.0
     original_npts = npts
+    interpolated = False
     if pairs:
         times, data = values[0::2], values[1::2]
         check_samples(times, name, f"the times of channel {number}")
@@ -449,6 +454,7 @@ def _read_channel(volume, start, block, has_marker, name, headonly, resample_int
             grid = times[0] + dt * np.arange(count)
             check_samples(data, name, f"channel {number} acceleration")
             data = np.interp(grid, times, data)
+            interpolated = True
             notes.append(f"{npts} time/value pairs at uneven times interpolated linearly onto"
                          f" {count} samples {dt} s apart")
             npts = count
@@ -515,6 +521,7 @@ def _read_channel(volume, start, block, has_marker, name, headonly, resample_int
             "dt": dt,
             "time_value_pairs": pairs,
             "original_npts": original_npts,
+            "interpolated": interpolated,
             "stated_peak_text": stated.group(0) if stated else "",
             # The same peak to more digits (signed): V1 in g, V2 in the unit of the samples.
             "real_header_peak": reals[_REAL_V1_MAX_G if volume == "V1" else _REAL_V2_PEAK],
@@ -545,7 +552,9 @@ def read_dmg(filename, headonly: bool = False, resample_interval=None, **kwargs)
         Read only the headers; the traces then have no samples (``stats.npts`` is set).
     resample_interval : float, optional
         Sampling interval [s] onto which time/value pairs at uneven times are interpolated; by
-        default their median time step, rounded to 0.001 s.
+        default their median time step, rounded to 0.001 s. Evenly sampled channels are returned
+        as stored, so the option is refused for a file without an uneven channel (a
+        :class:`RecordError`) rather than ignored.
     **kwargs
         Ignored (obspy passes its own keywords to every plug-in).
 
@@ -563,7 +572,7 @@ def read_dmg(filename, headonly: bool = False, resample_interval=None, **kwargs)
     RecordError
         If the file is not a CSMIP volume 1 or 2 file (a volume 3 file holds spectra), a header
         is broken or contradicts itself, the data are truncated, too long, not numbers, NaN/inf or
-        implausibly large.
+        implausibly large, or ``resample_interval`` is given for a file with no uneven channel.
     UnitsError
         If the unit of the samples is not stated, not an acceleration, or disagrees with the
         stated peak.
@@ -604,6 +613,11 @@ def read_dmg(filename, headonly: bool = False, resample_interval=None, **kwargs)
             trace.stats.npts = npts
         traces.append(trace)
     _check_all_channels(traces, name)
+    intervals = sorted({f"{trace.stats.delta:g}" for trace in traces})
+    check_resampling_applies(
+        name, "resample_interval", resample_interval,
+        any(trace.stats.shipblock_dmg.interpolated for trace in traces),
+        f"evenly sampled at {' and '.join(intervals)} s intervals")
     codes = [trace.stats.channel for trace in traces]
     if len(set(codes)) < len(codes):
         for trace in traces:

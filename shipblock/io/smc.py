@@ -33,7 +33,9 @@ What the real files (Loma Prieta 1989, gmprocess test corpus) show beyond that d
   and linearly interpolated onto an even grid at ``resample_rate`` (200 samples/s by default, the
   rate of the corrected files of the same event); times that repeat (the ``E10.4`` time field
   rounds to 1 ms after 10 s) are merged by averaging their values. The interpolated peak is within
-  0.5 % of the digitized one on these files.
+  0.5 % of the digitized one on these files. ``resample_rate`` means only this, as gmprocess's
+  read option of that name: given for an evenly sampled file (the corrected ``0111a/b/c.smc``, 200
+  samples/s) it is refused (:class:`RecordError`), not silently ignored.
 * Each of these pair files ends with one extra line of four pairs after the counted values. It
   does not continue the record: its times jump back (by up to 0.1 s) or forward (by 0.012 to
   1.6 s), and its values jump too (from -1.2 to -19.8 cm/s^2 in 12 ms in ``cra-1.0210g``). The
@@ -66,10 +68,11 @@ from obspy.core import AttribDict
 from shipblock.checks import how_to_pass
 from shipblock.errors import RecordError, UnitsError
 from shipblock.io._common import (
-    band_code,
     DEFAULT_RESAMPLE_RATE_HZ,
     FLOAT_RE,
+    band_code,
     check_plausible_samples,
+    check_resampling_applies,
     check_samples,
     check_sampling_interval,
     fixed_fields,
@@ -359,7 +362,7 @@ def _trim_pair_tail(values, per_line, npts, name) -> tuple[list[float], int]:
     )
 
 
-def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RESAMPLE_RATE_HZ,
+def read_smc(filename, headonly: bool = False, resample_rate: float | None = None,
              data_type: str | None = None, **kwargs) -> Stream:
     """Read a USGS SMC acceleration file into a Stream of one trace in m/s^2.
 
@@ -371,7 +374,10 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
         Return the trace without samples (``stats.npts`` still set).
     resample_rate : float, optional
         Sampling rate [samples/s] onto which an unevenly digitized record (time, value pairs) is
-        linearly interpolated. Evenly sampled records are returned as stored.
+        linearly interpolated; by default :data:`~shipblock.io._common.DEFAULT_RESAMPLE_RATE_HZ`
+        (200). An evenly sampled record is returned as stored, so the option is refused for it
+        (a :class:`RecordError`) rather than ignored: its rate is changed by the processing step
+        ``resample``, which filters against aliasing.
     data_type : {"acceleration"}, optional
         What the file holds when line 1 says ``0 UNKNOWN`` (PEER's ``.AT2.smc`` conversions are
         written so): ``"acceleration"`` reads it as an accelerogram in the format's cm/s^2 (the
@@ -391,7 +397,8 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
     ------
     RecordError
         If the file is not SMC, its header is broken, it holds spectra, its data count differs
-        from the header's, or samples are not finite.
+        from the header's, samples are not finite, or ``resample_rate`` is given for an evenly
+        sampled record.
     UnitsError
         If it holds velocity, displacement or an unknown data type.
     """
@@ -434,6 +441,10 @@ def read_smc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
         raise RecordError(name, f"sampling rate {rate:g} samples/s is not credible")
     if pairs and npts % 2:
         raise RecordError(name, f"holds (time, value) pairs but an odd value count {npts}")
+    check_resampling_applies(name, "resample_rate", resample_rate, pairs,
+                             f"evenly sampled at {rate:g} samples/s")
+    if resample_rate is None:
+        resample_rate = DEFAULT_RESAMPLE_RATE_HZ
 
     text = [line.rstrip() for line in lines[:_TEXT_LINES]]
     component = _COMPONENT_TEXT.search(text[5])

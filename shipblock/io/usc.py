@@ -26,7 +26,8 @@ What the real files (gmprocess test corpus, Northridge 1994) show:
 
 * Volume I samples are uneven (about 237 points/s, times printed to 1 ms); they are linearly
   interpolated onto an even grid at ``resample_rate`` (200 samples/s by default, as gmprocess
-  does, so the two agree sample for sample). The unit is g/10 (``UNITS ARE SEC AND G/10`` and
+  does, so the two agree sample for sample; the option is refused for a file of Volume II
+  channels only, which are evenly sampled and read as stored). The unit is g/10 (``UNITS ARE SEC AND G/10`` and
   real 4 = 0.100 agree); the stated RMS acceleration matches the record's to 1.5 %.
 * ``017m30bt.s0a``, which gmprocess refuses as "not a supported volume", is a valid Volume II:
   1887 instrument- and baseline-corrected samples at 0.02 s in cm/s^2, band-passed 0.225-0.325 to
@@ -71,6 +72,7 @@ from shipblock.io._common import (
     DEFAULT_RESAMPLE_RATE_HZ,
     FLOAT_RE,
     check_plausible_samples,
+    check_resampling_applies,
     check_samples,
     check_sampling_interval,
     fixed_fields,
@@ -485,7 +487,7 @@ def _trace(samples, delta, factor, unit, header, ints, text, name, headonly):
     return trace
 
 
-def read_usc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RESAMPLE_RATE_HZ,
+def read_usc(filename, headonly: bool = False, resample_rate: float | None = None,
              **kwargs) -> Stream:
     """Read a USC Volume I or II file into a Stream of acceleration traces in m/s^2.
 
@@ -497,7 +499,9 @@ def read_usc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
         Return traces without samples (``stats.npts`` still set).
     resample_rate : float, optional
         Sampling rate [samples/s] onto which Volume I's uneven digitized points are linearly
-        interpolated.
+        interpolated; by default :data:`~shipblock.io._common.DEFAULT_RESAMPLE_RATE_HZ` (200).
+        Volume II is evenly sampled and returned as stored, so the option is refused for a file
+        without a Volume I channel (a :class:`RecordError`) rather than ignored.
     **kwargs
         Ignored (obspy passes its own keywords to every plug-in).
 
@@ -513,7 +517,8 @@ def read_usc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
     ------
     RecordError
         If the file is not a USC Volume I/II, a header is broken, the data are truncated or longer
-        than stated, digitized times go backwards, or samples are not finite.
+        than stated, digitized times go backwards, samples are not finite, or ``resample_rate``
+        is given for a file of Volume II channels only.
     UnitsError
         If the unit is missing, unknown or contradicted by the header.
     """
@@ -526,6 +531,7 @@ def read_usc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
         raise RecordError(name, "is a USC Volume III (response spectra), not a time series")
     traces = []
     index = 0
+    rate = DEFAULT_RESAMPLE_RATE_HZ if resample_rate is None else resample_rate
     while index < len(lines):
         line = lines[index]
         if not line.strip():
@@ -534,11 +540,16 @@ def read_usc(filename, headonly: bool = False, resample_rate: float = DEFAULT_RE
         if _is_v2_start(line) and index + 1 < len(lines) and _is_v1_start(lines[index + 1]):
             trace, index = _read_v2(lines, index, name, headonly)
         elif _is_v1_start(line):
-            trace, index = _read_v1(lines, index, name, resample_rate, headonly)
+            trace, index = _read_v1(lines, index, name, rate, headonly)
         else:
             where = "does not start" if not traces else f"line {index + 1} does not start"
             raise RecordError(
                 name, f"{where} a USC Volume I or II channel ({line.strip()[:40]!r})"
             )
         traces.append(trace)
+    rates = sorted({f"{trace.stats.sampling_rate:g}" for trace in traces})
+    check_resampling_applies(
+        name, "resample_rate", resample_rate,
+        any(trace.stats.shipblock_usc.volume == "I" for trace in traces),
+        f"a Volume II, evenly sampled at {' and '.join(rates)} samples/s")
     return Stream(traces)

@@ -132,9 +132,10 @@ def add_read_arguments(g) -> None:
                         " acceleration, in the format's cm/s^2, can be read)")
     g.add_argument("--resample-rate", type=float, metavar="HZ",
                    help="rate onto which SMC/USC files of (time, value) pairs are interpolated"
-                        " [samples/s] (default 200)")
+                        " [samples/s] (default 200); refused for an evenly sampled file")
     g.add_argument("--resample-interval", type=float, metavar="SECONDS",
-                   help="interval of a DMG file's resampling [s]")
+                   help="interval onto which a DMG file's uneven time/value pairs are"
+                        " interpolated [s]; refused for an evenly sampled file")
 
 
 def _channel_map(items) -> dict | None:

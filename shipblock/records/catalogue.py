@@ -17,6 +17,7 @@ import numpy as np
 
 from shipblock import checks
 from shipblock.errors import ParameterError, ParameterTypeError, RecordError
+from shipblock.io import code_from_name
 from shipblock.records.arguments import check_read_arguments
 from shipblock.records.folders import MotionSet
 from shipblock.records.motion import COMPONENTS, GroundMotion
@@ -343,16 +344,17 @@ def _inventory_file(motion, inventories: dict) -> Path | None:
 def _id_part(text: str) -> str:
     """A piece of a record id: runs of anything but letters, digits, ``_`` and ``-`` become one
     ``-`` (``"Anaheim - Lakeview & Riverdale"`` -> ``"Anaheim-Lakeview-Riverdale"``)."""
-    return re.sub(r"[^A-Za-z0-9_]+", "-", text).strip("-")
+    return code_from_name(text)
 
 
 def record_id(motion: GroundMotion) -> str:
     """The catalogue id of a record: ``NET.STA.LOC.SENSOR`` (SEED codes, e.g. ``NP.1765..HN``).
 
     A record without a network code (PEER AT2, Kinemetrics EVT, SMC) is named by its station and
-    its channels instead, each cleaned by :func:`_id_part`: ``Corralitos.0`` (Loma Prieta,
-    ``RSN753_LOMAP_CLS000.AT2``), ``Anaheim-Lakeview-Riverdale.360-90``. Ids never start with a
-    dot or hold spaces, so that file names made of them are neither hidden nor quoted.
+    sensor (or its channels when they are no SEED codes) instead, each cleaned by
+    :func:`_id_part`: ``CORRALITOS.HN`` (Loma Prieta, ``RSN753_LOMAP_CLS000.AT2``, read as
+    ``.CORRALITOS..HNN``), ``ANAHEIM-LAKEVIEW-RIVERDALE.HN``. Ids never start with a dot or hold
+    spaces, so that file names made of them are neither hidden nor quoted.
 
     Parameters
     ----------

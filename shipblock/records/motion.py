@@ -477,7 +477,7 @@ def require_components(motion: GroundMotion, components, *, record: str, key: st
 
     Examples
     --------
-    >>> require_components(motion, ("H1", "V"), record="Corralitos.0",
+    >>> require_components(motion, ("H1", "V"), record="CORRALITOS.HN",
     ...                    key='vertical = "same"')  # doctest: +SKIP
     """
     held = set(motion.components)

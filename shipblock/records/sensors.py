@@ -90,8 +90,8 @@ def sensor_code(trace: Trace) -> str:
     """``"<location>.<band+instrument>"`` of a trace, e.g. ``"02.HN"``: one sensor of a station.
 
     Only SEED channel codes (three characters, band and instrument letters first) name a sensor;
-    other codes (an AT2 file's ``"180"`` or ``"DWN"``, marked by its reader with
-    ``stats.seed_channel = False``; an EVT file's ``"0"``) leave it empty.
+    other codes (the codes the AT2 reader makes from a component word, ``HN1`` from ``180``,
+    marked ``stats.seed_channel = False``; an EVT file's ``"0"``) leave it empty.
     """
     channel = trace.stats.channel
     seed = trace.stats.get("seed_channel", True) and len(channel) == 3 and channel[:2].isalpha()
@@ -131,7 +131,10 @@ def select_sensor(stream: Stream, sensor: str | None, channel_map, strict: bool 
 
 def _match_map(trace: Trace, channel_map: Mapping[str, str]):
     source = trace_source(trace)
-    for key in (trace.id, trace.stats.channel, os.path.basename(source), source):
+    # file_component: the component as the file writes it, when the reader made the channel
+    # code (an AT2 file's "180" for HN1), so that a map written for the file's words works
+    for key in (trace.id, trace.stats.channel, trace.stats.get("file_component"),
+                os.path.basename(source), source):
         if key in channel_map:
             return channel_map[key]
     return None
@@ -246,15 +249,17 @@ def assign_components(
 #: and ``simulate`` and documented in docs/user_guide/records.rst.
 HORIZONTAL_RULE = (
     "H1 is the record's first horizontal: N before E and 1 before 2 by the channel codes'"
-    " last letters; otherwise the first in the file (a file holding all components, e.g. a"
-    " CSMIP V2), or, for one file per component, the one the other is 90 deg clockwise from"
-    " (PEER 000/090: 000), else the first file given"
+    " last letters (not the codes made from PEER component words); otherwise the first in the"
+    " file (a file holding all components, e.g. a CSMIP V2), or, for one file per component,"
+    " the one the other is 90 deg clockwise from (PEER 000/090: 000), else the first file given"
 )
 
 
 def _order_horizontals(horizontals, info):
-    """H1 first (:data:`HORIZONTAL_RULE`)."""
-    letters = [orientation_letter(tr.stats.channel) for tr in horizontals]
+    """H1 first (:data:`HORIZONTAL_RULE`). Channel codes a reader made (``seed_channel``
+    False: AT2) are not the file's: their order comes from the azimuths."""
+    letters = [orientation_letter(tr.stats.channel) if tr.stats.get("seed_channel", True) else ""
+               for tr in horizontals]
     for first, second in (("N", "E"), ("1", "2")):
         if set(letters) == {first, second}:
             return sorted(
