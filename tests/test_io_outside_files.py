@@ -16,7 +16,7 @@ import pytest
 from obspy import UTCDateTime
 
 from shipblock import read_motion
-from shipblock.errors import UnitsError
+from shipblock.errors import RecordError, UnitsError
 from shipblock.io import read_record
 from shipblock.records.folders import read_motions as read_motion_set
 from tests.real_corpus import outside_file
@@ -218,6 +218,22 @@ def test_peer_diagonal_pair_and_dotted_station_name(tmp_path):
     motion = read_motion(files)
     assert motion.azimuths == {"H1": 315.0, "H2": 45.0}
     np.testing.assert_allclose(motion.components["H1"], _at2_samples(files[1]) * G, rtol=1e-6,
+                               atol=1e-12)
+
+
+def test_peer_fault_normal_component_is_not_taken_for_north(tmp_path):
+    """A PEER component rotated to the fault (``FN``) states no azimuth: its code ends in N by
+    chance and must not make it the north horizontal of a pair with an east one (``90``); the
+    pair is refused until a ``channel_map`` names the component, and then read as named."""
+    east, other = tmp_path / "east.AT2", tmp_path / "FN.AT2"
+    east.write_text(outside_file(ANAHEIM[0]).read_text())
+    other.write_text(re.sub(r", 360\n", ", FN\n", outside_file(ANAHEIM[1]).read_text(), count=1))
+    fault = read_record(other)[0]
+    assert fault.stats.channel == "FN" and fault.stats.get("azimuth") is None
+    with pytest.raises(RecordError, match="FN"):
+        read_motion([east, other])
+    motion = read_motion([east, other], channel_map={"FN": "H1", "HNE": "H2"})
+    np.testing.assert_allclose(motion.components["H1"], _at2_samples(other) * G, rtol=1e-6,
                                atol=1e-12)
 
 

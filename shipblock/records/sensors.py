@@ -64,8 +64,11 @@ def _orientation(trace: Trace, inventory):
         if dip is None and found.get("dip") is not None:
             dip = float(found["dip"])
     letter = orientation_letter(stats.channel)
-    if stats.get("_format") in CHANNEL_NUMBER_FORMATS:
-        letter = ""  # "1", "2" are channel numbers there, not orientations: channel_map tells
+    if stats.get("_format") in CHANNEL_NUMBER_FORMATS or not stats.get("seed_channel", True):
+        # "1", "2" are channel numbers there, not orientations; a code a reader made from a word
+        # that states no orientation (PEER's fault-normal "FN") ends in N by chance:
+        # channel_map tells
+        letter = ""
     if dip is not None:
         if abs(abs(dip) - 90.0) <= ORIENTATION_TOLERANCE:
             return "V", None, float(math.copysign(90.0, dip)), note
