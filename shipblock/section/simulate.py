@@ -540,8 +540,8 @@ class SectionRunner:
     initial_state : InitialState, optional
         The section's static state, :func:`rest_state` of its assembly solved once by the
         caller (a dock that must settle first costs a full run to solve); checked against this
-        runner's assembly (:func:`~shipblock.section.model.check_static_state`: the same state
-        bit for bit, settled at the same ``separation_height``), so the runs equal those from
+        runner's assembly (:func:`~shipblock.section.model.check_static_state`: solved for an
+        equal section, settled at the same ``separation_height``), so the runs equal those from
         the runner's own solve. Default: solved here.
     **options
         The options of :func:`simulate_section` (checked here, an unknown one a TypeError).
