@@ -19,6 +19,7 @@ from shipblock.section import NAVY_BLOCK
 from shipblock.units import STANDARD_GRAVITY as G
 
 from .test_batch import make_catalogue
+from .test_section_study import SETTLING, _counting_rest_state
 from .test_section_study import SYSTEM  # a 30 t ship on two narrow Navy keel blocks
 
 
@@ -179,3 +180,19 @@ def test_a_plain_rigid_system_file_names_its_missing_keys(tmp_path, records, cap
     capsys.readouterr()
     with xr.open_dataset(out) as ds:
         assert ds.attrs["solver_rtol"] == 1e-6
+
+
+def test_a_settling_dock_is_settled_once_per_simulate(tmp_path, records, capsys, monkeypatch):
+    """``simulate --system`` on a dock that must settle before its static solve (a full run):
+    the state the system's check solved is the one the run starts from (one solve, not two);
+    with ``--ship-mass`` the file's dock is checked and the heavier one solved (two)."""
+    calls = _counting_rest_state(monkeypatch)
+    table = "\n".join(f"{k} = {v}" for k, v in SETTLING.items())
+    system = f'[system]\nmodel = "section"\n{table}\n'
+    assert _simulate(tmp_path, records, "--scale", "1e-5", system=system) == 0
+    assert len(calls) == 1
+    assert "none" in capsys.readouterr().out.split("failure", 1)[1].splitlines()[0]
+    calls.clear()
+    assert _simulate(tmp_path, records, "--scale", "1e-5", "--ship-mass", "650 t",
+                     system=system) == 0
+    assert [asm.section.ship.mass for asm in calls] == [6e5, 6.5e5]

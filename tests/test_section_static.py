@@ -9,14 +9,18 @@ agree to the order of the rotations (~1e-6 here), so the tolerances are 1e-4, fa
 sign or factor error in a load path would give.
 """
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from shipblock.bench.section_campaign import random_case
-from shipblock.errors import ParameterError
-from shipblock.section import NAVY_BLOCK, Block, BlockLine, Cap, DockSection, Ship, Wind
+from shipblock.errors import ParameterError, ParameterTypeError
+from shipblock.section import (NAVY_BLOCK, Block, BlockLine, Cap, DockSection, SectionRunner, Ship,
+                               Wind)
 from shipblock.section import _kernel as K
-from shipblock.section.model import NoStaticSolution, assemble, static_state
+from shipblock.section import simulate as simulate_mod
+from shipblock.section.model import NoStaticSolution, assemble, static_state, sunk_state
 from shipblock.section.simulate import rest_state, simulate_section
 
 G = 9.80665
@@ -248,6 +252,65 @@ def test_a_side_line_that_slips_as_the_ship_lands_starts_from_where_it_stuck():
     assert np.all(demand[loaded] <= asm.strip_f[loaded, K.SF_MUS] * init.normal[loaded])
     moved, events = _at_rest(dock)
     assert moved < 1e-12 and events == ["start"]
+
+
+def _counting_rest_state(monkeypatch):
+    """Count the calls of rest_state made by SectionRunner (the list of their assemblies)."""
+    calls = []
+
+    def counted(asm):
+        calls.append(asm)
+        return rest_state(asm)
+
+    monkeypatch.setattr(simulate_mod, "rest_state", counted)
+    return calls
+
+
+def test_a_runner_given_the_settled_rest_state_runs_as_one_that_settles_the_dock(monkeypatch):
+    """The slick side line settles before its static solve (a full run): a runner handed that
+    state (solved once by the caller) does not solve it again, and its runs equal, bit for
+    bit, those of a runner that settles the dock itself, under a motion that slides the ship."""
+    dock = _slick_side_line()
+    init = rest_state(assemble(dock))
+    assert init.settled_separation_height == 0.02
+    dt = 0.01
+    t = np.arange(0.0, 6.0, dt)
+    h = 2.0 * np.sin(2 * np.pi * 1.5 * t) * np.sin(np.pi * t / 6.0) ** 2
+    v = 0.5 * np.sin(2 * np.pi * 4.0 * t) * np.sin(np.pi * t / 6.0) ** 2
+    calls = _counting_rest_state(monkeypatch)
+    own = SectionRunner(dock)
+    assert len(calls) == 1
+    given = SectionRunner(dock, initial_state=init)
+    assert len(calls) == 1 and given.initial_state is init
+    np.testing.assert_array_equal(own.initial_state.x, init.x)
+    a, b = own(h, v, dt), given(h, v, dt)
+    assert a.summary == b.summary
+    assert a.summary["side0_peak_slip"] > 1e-4  # the motion moves the dock
+    np.testing.assert_array_equal(a.ship, b.ship)
+    assert a.energy == b.energy and a.events == b.events
+
+
+def test_a_runner_refuses_a_state_that_is_not_its_sections():
+    """A state solved for another section (another ship mass, or no side line), or for this one
+    settled at another separation height, the sunk start (not a static state) or something
+    else is refused naming initial_state, not run from; one of an equal section built again
+    is taken."""
+    dock = _slick_side_line()
+    init = rest_state(assemble(dock))
+    assert init.section == dock
+    assert SectionRunner(_slick_side_line(), initial_state=init).initial_state is init
+    heavier = dataclasses.replace(dock, ship=dataclasses.replace(dock.ship, mass=6.5e5))
+    for other in (heavier, keel_only(0.1)):
+        with pytest.raises(ParameterError, match="initial_state is not the static state of "
+                                                 "this section: it was solved for another"):
+            SectionRunner(other, initial_state=init)
+    with pytest.raises(ParameterError, match=r"settled with separation_height = 0.02 m, this "
+                                             r"run has 0.05 m"):
+        SectionRunner(dock, initial_state=init, separation_height=0.05)
+    with pytest.raises(ParameterError, match="it was solved for none"):
+        SectionRunner(dock, initial_state=sunk_state(assemble(dock)))
+    with pytest.raises(ParameterTypeError, match="initial_state must be an InitialState"):
+        SectionRunner(dock, initial_state=init.x)
 
 
 def test_a_dock_that_tips_when_left_to_settle_is_refused_saying_so():

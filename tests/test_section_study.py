@@ -28,11 +28,15 @@ from shipblock.fragility import batch as batch_mod
 from shipblock.fragility.keys import key_table
 from shipblock.fragility.pipeline import PipelineError, load_pipeline, rerun_case, run_pipeline
 from shipblock.models import FieldError, get_model
+from shipblock.models import section as section_model
 from shipblock.models.section import EDP_VARIABLES, FAILURE_CODES, FAILURE_FLAGS, PARAMETERS
 from shipblock.plot import plot_ida, plot_median_sweep, study_caption
 from shipblock.report import write_report
 from shipblock.risk import risk_integral
-from shipblock.section import NAVY_BLOCK
+from shipblock.section import NAVY_BLOCK, SectionRunner
+from shipblock.section import simulate as section_simulate
+from shipblock.section.model import SlidesAtRest, assemble, static_state
+from shipblock.section.simulate import rest_state
 from shipblock.units import STANDARD_GRAVITY as G
 
 from .test_batch import make_catalogue, synthetic_motion
@@ -292,6 +296,108 @@ def test_a_run_that_raises_is_a_solver_error_row_and_the_others_are_kept(monkeyp
     assert list(out["failure"]) == [0.0, 6.0, 0.0]
     assert np.isnan(out["keel_load_ratio"][1]) and out["keel_load_ratio"][0] > 0
     assert out["keel_load_ratio"][0] == out["keel_load_ratio"][2]
+
+
+# a dock whose first static solve fails (the side line's slick caps under the sloped hull
+# would slide from the touching position: tests/test_section_static.py's _slick_side_line, the
+# keel caps slick too): rest_state lets it settle for 20 s first, a full run
+SETTLING = {"ship_mass": 6e5, "roll_inertia": 5.4e6, "g_height": 3.0, "keel_half_width": 0.8,
+            "half_beam": 6.0, "g_offset": 0.3, "keel_blocks": 4, "side_lines": 1,
+            "side_blocks": 2, "side_offset": 3.5, "side_hull_height": 0.3,
+            "side_hull_slope": 0.3, "mu_s_top": 0.05, "mu_k_top": 0.05, "mu_s_bottom": 0.05,
+            "mu_k_bottom": 0.05}
+
+
+def _counting_rest_state(monkeypatch) -> list:
+    """Count the static solves of the section model's build and of the section runners."""
+    calls = []
+
+    def counted(asm):
+        calls.append(asm)
+        return rest_state(asm)
+
+    monkeypatch.setattr(section_model, "rest_state", counted)
+    monkeypatch.setattr(section_simulate, "rest_state", counted)
+    return calls
+
+
+def _assert_same(a: dict, b: dict):
+    """The same outputs, bit for bit (NaN for NaN)."""
+    assert a.keys() == b.keys()
+    np.testing.assert_array_equal(list(a.values()), list(b.values()))
+
+
+def test_a_settling_dock_is_settled_once_per_system(monkeypatch):
+    """The system carries the static state its build checked (a settled one here), and every
+    run of it starts from that state: chunks of a batch, a history, a copy pickled for a worker;
+    varying the system settles the new dock, and a study option with another separation height
+    settles it again at that height. Every run equals, bit for bit, that of a runner that
+    solves the state itself (the code before the state was kept)."""
+    model = get_model("section")
+    calls = _counting_rest_state(monkeypatch)
+    system = model.build(SETTLING)
+    assert len(calls) == 1 and system.rest.settled_separation_height == 0.02
+    with pytest.raises(SlidesAtRest):  # the first solve alone refuses the dock
+        static_state(assemble(system.section))
+    h1, h2, v, dt = synthetic_motion(3)
+    inputs = [(h1, v), (2.0 * h2, None), (3.0 * h1, 3.0 * v)]
+    chunks = [model.run_batch([system], inputs, [dt] * 3, np.array([[0, 0], [1, 0]])),
+              model.run_batch([system], inputs, [dt] * 3, np.array([[2, 0]]))]
+    run = model.simulate(system, *inputs[2], dt)
+    twin = pickle.loads(pickle.dumps(system))
+    again = twin.runner()(*inputs[0], dt)
+    assert len(calls) == 1
+    # the runs a runner solving its own state gives
+    fresh = [section_model.outputs(system.section, SectionRunner(system.section)(h, w, dt))
+             for h, w in inputs]
+    assert len(calls) == 4
+    for name in fresh[0]:
+        np.testing.assert_array_equal([*chunks[0][name], *chunks[1][name]],
+                                      [row[name] for row in fresh], err_msg=name)
+    _assert_same(run.summary, fresh[2])
+    assert again.summary == SectionRunner(system.section)(*inputs[0], dt).summary
+    assert np.isnan(fresh[0]["failure_time"]) and fresh[0]["side0_peak_slip"] > 1e-4
+    # a varied system settles its own dock: another state, its runs its own
+    calls.clear()
+    varied = model.vary(system, {"g_offset": 0.25})
+    assert len(calls) == 1 and varied.rest.settled_separation_height == 0.02
+    assert not np.array_equal(varied.rest.x, system.rest.x)
+    _assert_same(model.simulate(varied, *inputs[0], dt).summary,
+                 section_model.outputs(varied.section,
+                                       SectionRunner(varied.section)(*inputs[0], dt)))
+    # a study's other separation height: the dock is settled again at that height
+    calls.clear()
+    higher = system.runner(separation_height=0.05)
+    assert len(calls) == 1 and higher.initial_state.settled_separation_height == 0.05
+    assert (higher(*inputs[2], dt).summary
+            == SectionRunner(system.section, separation_height=0.05)(*inputs[2], dt).summary)
+
+
+def test_a_study_of_a_settling_dock_settles_each_system_once(tmp_path, monkeypatch):
+    """A swept study (2 systems, 36 runs in 4 chunks, a history) of the settling dock: one
+    static solve per system (and the base system's), and every result equal to the study run
+    with runners that solve the state themselves, chunk by chunk."""
+    table = "\n".join(f"{k} = {v}" for k, v in SETTLING.items() if not k.startswith("mu_"))
+    system = f'[system]\nmodel = "section"\n{table}\nmu_s_bottom = 0.8\nmu_k_bottom = 0.7\n'
+    path = write(tmp_path / "kept", system=system)
+    calls = _counting_rest_state(monkeypatch)
+    kept = run_pipeline(path, progress=False)
+    assert len(calls) == 3
+    settled = []
+    for asm in calls:
+        try:
+            static_state(asm)
+        except SlidesAtRest:
+            settled.append(asm.section)
+    assert len(settled) == 2  # both swept docks (mu_top 0.1, 0.3) settle, the base does not
+    assert (kept["failure"] == 0).any() and (kept["failure"] != 0).any()
+    monkeypatch.setattr(section_model.SectionSystem, "runner",
+                        lambda self, **options: SectionRunner(self.section, **options))
+    calls.clear()
+    solved = run_pipeline(write(tmp_path / "solved", system=system), progress=False)
+    assert len(calls) == 3 + 4 * 2 + 1  # and one per chunk and system, one for the history
+    xr.testing.assert_identical(kept.drop_attrs(deep=False).drop_vars("history_file"),
+                                solved.drop_attrs(deep=False).drop_vars("history_file"))
 
 
 @pytest.mark.parametrize(("edit", "key", "needle"), [

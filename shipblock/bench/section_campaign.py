@@ -45,7 +45,7 @@ import numpy as np
 
 from shipblock.errors import ParameterError
 from shipblock.section import Block, BlockLine, Cap, DockSection, Ship, Wind
-from shipblock.section.simulate import DEFAULT_ATOL, DEFAULT_RTOL, simulate_section
+from shipblock.section.simulate import DEFAULT_ATOL, DEFAULT_RTOL, SectionRunner, simulate_section
 from shipblock.units import STANDARD_GRAVITY
 
 __all__ = ["COMPARE_RTOL", "ENERGY_TOL", "campaign", "random_case", "run_case", "summarise"]
@@ -213,7 +213,8 @@ def run_case(seed: int, case: int, compare: bool = True) -> dict:
     try:
         dock, (h, v, dt), desc = random_case(seed, case)
         rec.update(desc)
-        res = simulate_section(dock, h, v, dt)
+        runner = SectionRunner(dock)  # its static state serves the tight run too
+        res = runner(h, v, dt)
     except ParameterError as err:
         rec.update(outcome="refused", reason=_reason(str(err)))
         return rec
@@ -228,8 +229,8 @@ def run_case(seed: int, case: int, compare: bool = True) -> dict:
     if compare:
         try:
             # Dormand-Prince throughout: a second integrator, not only a tighter tolerance
-            tight = simulate_section(dock, h, v, dt, rtol=COMPARE_RTOL, atol=COMPARE_ATOL,
-                                     exponential_steps=False)
+            tight = SectionRunner(dock, initial_state=runner.initial_state, rtol=COMPARE_RTOL,
+                                  atol=COMPARE_ATOL, exponential_steps=False)(h, v, dt)
         except Exception:  # noqa: BLE001
             rec.update(outcome="exception", error="tight run: " + traceback.format_exc(limit=3))
             return rec

@@ -25,6 +25,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -466,15 +467,31 @@ class AnalysisDesign:
         ------
         ParameterError
             If the combination gives an invalid system (names the combination).
+
+        Notes
+        -----
+        Each system is built once per design and kept (:meth:`validate`, the batch and a rerun
+        use the same one): building one can cost a full run (the section model solves its
+        static state, letting a dock settle first where it must).
         """
         if not self.sweep:
             return self.system
-        combo = np.unravel_index(int(index), self.sweep_shape)
+        index = int(index)
+        if index in self._built:
+            return self._built[index]
+        combo = np.unravel_index(index, self.sweep_shape)
         values = {name: vals[int(i)] for (name, vals), i in zip(self.sweep, combo, strict=True)}
         try:
-            return self.model.vary(self.system, values)
+            system = self.model.vary(self.system, values)
         except ValueError as exc:
             raise ParameterError(f"sweep {values}: {exc}") from None
+        self._built[index] = system
+        return system
+
+    @cached_property
+    def _built(self) -> dict:
+        """The swept systems built so far, by index (the design is frozen: they stay valid)."""
+        return {}
 
     def case_indices(self, cases) -> np.ndarray:
         """Grid indices of case numbers.

@@ -74,7 +74,7 @@ import numpy as np
 from shipblock.errors import ParameterError, ShipblockError
 from shipblock.models.base import EDPInfo, Field, FieldError, Model
 from shipblock.section import NAVY_BLOCK, Block, BlockLine, Cap, DockSection, Ship, Wind
-from shipblock.section.model import assemble
+from shipblock.section.model import InitialState, assemble
 from shipblock.section.parameters import (
     CAP_MATERIALS,
     DEFAULT_CAP_MATERIAL,
@@ -93,7 +93,6 @@ from shipblock.section.simulate import (
     SectionResult,
     SectionRunner,
     rest_state,
-    simulate_section,
 )
 from shipblock.units import STANDARD_GRAVITY
 
@@ -317,19 +316,37 @@ RUN_VARIABLES: Mapping[str, tuple[str, str]] = MappingProxyType(_run_variables()
 
 @dataclass(frozen=True)
 class SectionSystem:
-    """A dock section as a study holds it: the ``[system]`` values as given and the section.
+    """A dock section as a study holds it: the ``[system]`` values as given, the section and
+    the static state its runs start from.
 
     Attributes
     ----------
     values : dict
         The given ``[system]`` parameters (checked, SI units); derived defaults are derived
-        again from them when a study varies one (:meth:`SectionModel.vary`).
+        again from them when a study varies one (:meth:`SectionModel.vary`, which builds a new
+        system and solves its state).
     section : DockSection
         The section they describe.
+    rest : InitialState or None
+        :func:`~shipblock.section.simulate.rest_state` of the section, solved once by
+        :meth:`SectionModel.build` (which refuses a dock without one) and handed to every
+        runner of the system, here or in a worker process (it pickles with the system); None:
+        each runner solves it.
     """
 
     values: dict
     section: DockSection = field(repr=False)
+    rest: InitialState | None = field(default=None, repr=False, compare=False)
+
+    def runner(self, **options) -> SectionRunner:
+        """A :class:`~shipblock.section.SectionRunner` of the section with ``options``,
+        starting from :attr:`rest` (unless that was settled at another ``separation_height``
+        than the options': then the runner settles the dock again at theirs)."""
+        rest = self.rest
+        if rest is not None and rest.settled_separation_height not in (
+                None, options.get("separation_height", DEFAULT_SEPARATION_HEIGHT)):
+            rest = None
+        return SectionRunner(self.section, initial_state=rest, **options)
 
 
 # first dotted name of a section error -> the [system] key (relations: see _key_of)
@@ -588,8 +605,9 @@ class SectionModel(Model):
 
         Every value is checked by its declaration (the range of the section's own checks),
         then the section is built (:class:`~shipblock.section.DockSection`) and its static
-        state solved, so that a dock whose caps crush at rest or whose ship is unstable on its
-        blocks is refused here, before any run.
+        state solved (:func:`~shipblock.section.simulate.rest_state`), so that a dock whose
+        caps crush at rest or whose ship is unstable on its blocks is refused here, before any
+        run; the system keeps the state for its runs (:attr:`SectionSystem.rest`).
 
         Raises
         ------
@@ -603,12 +621,12 @@ class SectionModel(Model):
                 raise FieldError(name, f"missing: {f.doc} [{f.units}]")
         try:
             section = _section(table)
-            rest_state(assemble(section))
+            rest = rest_state(assemble(section, DEFAULT_SEPARATION_HEIGHT))
         except FieldError:
             raise
         except ParameterError as exc:
             raise FieldError(_key_of(str(exc), table), str(exc)) from None
-        return SectionSystem(table, section)
+        return SectionSystem(table, section, rest)
 
     def vary(self, system: SectionSystem, values: Mapping[str, Any]) -> SectionSystem:
         """``system`` with swept parameters changed (derived defaults derived again).
@@ -672,12 +690,12 @@ class SectionModel(Model):
         """
         cases = np.asarray(cases, dtype=np.int64).reshape(-1, 2)
         out = {name: np.full(len(cases), np.nan) for name in RUN_VARIABLES}
-        runners = {}  # per system: its static state and exponential steps, made once
+        runners = {}  # per system: its exponential steps made once (its state is the system's)
         for k, (i, s) in enumerate(cases.tolist()):
             h, v = inputs[i]
             try:
                 if s not in runners:
-                    runners[s] = SectionRunner(systems[s].section, **options)
+                    runners[s] = systems[s].runner(**options)
                 row = outputs(systems[s].section, runners[s](h, v, dts[i]))
             except (ShipblockError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
                 logger.warning("section run (input %d, system %d) failed: %s", i, s, exc)
@@ -688,8 +706,9 @@ class SectionModel(Model):
 
     def simulate(self, system: SectionSystem, horizontal, vertical, dt: float,
                  **options) -> SectionRun:
-        """One run with its histories (:func:`~shipblock.section.simulate_section`)."""
-        result = simulate_section(system.section, horizontal, vertical, dt, **options)
+        """One run with its histories (:func:`~shipblock.section.simulate_section`, from the
+        system's static state)."""
+        result = system.runner(**options)(horizontal, vertical, dt)
         h = np.asarray(horizontal, dtype=float)
         v = np.zeros_like(h) if vertical is None else np.asarray(vertical, dtype=float)
         return SectionRun(result, outputs(system.section, result), np.column_stack([h, v]))

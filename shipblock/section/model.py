@@ -67,12 +67,13 @@ import numpy as np
 from numpy.polynomial import legendre
 from scipy import optimize
 
-from shipblock.errors import ParameterError
+from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.section import _kernel as K
 from shipblock.section.parameters import DockSection
 
-__all__ = ["Assembly", "NoStaticSolution", "SlidesAtRest", "assemble", "damping_for_restitution",
-           "impact_restitution", "lobatto", "static_state", "sunk_state"]
+__all__ = ["Assembly", "InitialState", "NoStaticSolution", "SlidesAtRest", "assemble",
+           "check_static_state", "damping_for_restitution", "impact_restitution", "lobatto",
+           "static_state", "sunk_state"]
 
 #: Largest rotation the model is written for [rad] (beyond it a run stops as out of validity).
 MAX_ANGLE = math.pi / 3.0
@@ -326,7 +327,24 @@ def tangent_coordinates(asm: Assembly, q: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class InitialState:
-    """The static state a run starts from (:func:`static_state`)."""
+    """The static state a run starts from (:func:`static_state`).
+
+    Attributes
+    ----------
+    x : numpy.ndarray
+        The kernel's state (positions, zero velocities, each strip's stick spring).
+    regime, plastic_set, spring_force : numpy.ndarray
+        Per spring: its regime, permanent set [m] (none) and force [N].
+    friction, normal : numpy.ndarray
+        Per strip: its friction state and normal force [N] (whole line).
+    section : DockSection or None
+        The section it was solved for (None: not a static state, :func:`sunk_state`).
+    settled_separation_height : float or None
+        The separation height [m] of the run that let the dock settle before the solve
+        (:func:`shipblock.section.simulate.rest_state`): that run stops at a separation, so the
+        state is one of assemblies with this separation height only. None: solved without
+        settling, a state of the section at every separation height.
+    """
 
     x: np.ndarray
     regime: np.ndarray
@@ -334,6 +352,8 @@ class InitialState:
     friction: np.ndarray
     normal: np.ndarray  # per strip [N], whole line
     spring_force: np.ndarray  # per spring [N], whole line
+    section: DockSection | None = dataclasses.field(default=None, repr=False)
+    settled_separation_height: float | None = None
 
 
 def _forces(asm: Assembly, q: np.ndarray, u: np.ndarray):
@@ -557,4 +577,48 @@ def static_state(asm: Assembly, start: np.ndarray | None = None,
                 f"{demand[j] / normal[j]:.3g}, above its mu_s "
                 f"({asm.strip_f[j, K.SF_MUS]:.3g}): the line would slide under the static load "
                 "(a hull slope too steep for the friction, or an unbalanced side line)")
-    return InitialState(x, reg, np.zeros(asm.spring_f.shape[0]), fs, normal, fn)
+    return InitialState(x, reg, np.zeros(asm.spring_f.shape[0]), fs, normal, fn, asm.section)
+
+
+def check_static_state(asm: Assembly, state, name: str = "initial_state") -> InitialState:
+    """``state`` checked as the static state of ``asm``, to start its runs from.
+
+    It must have been solved for an equal section (:attr:`InitialState.section`: every
+    parameter the same; the static solve and the settling are deterministic, so the runs from
+    it equal those from solving it again), and one that
+    :func:`~shipblock.section.simulate.rest_state` found after letting the dock settle at
+    ``asm``'s separation height (:attr:`InitialState.settled_separation_height`).
+
+    Parameters
+    ----------
+    asm : Assembly
+    state : InitialState
+        From :func:`static_state` or :func:`~shipblock.section.simulate.rest_state`.
+    name : str
+        What to call ``state`` in an error.
+
+    Returns
+    -------
+    InitialState
+        ``state``.
+
+    Raises
+    ------
+    ParameterTypeError
+        If ``state`` is not an :class:`InitialState`.
+    ParameterError
+        If it is not the static state of ``asm`` (naming ``name`` and why).
+    """
+    if not isinstance(state, InitialState):
+        raise ParameterTypeError(f"{name} must be an InitialState (rest_state's), got "
+                                 f"{type(state).__name__}")
+    if state.section is None or state.section != asm.section:
+        raise ParameterError(f"{name} is not the static state of this section: it was solved "
+                             f"for {'none' if state.section is None else 'another section'} "
+                             "(rest_state of this section's assembly is)")
+    settled = state.settled_separation_height
+    if settled is not None and settled != asm.opt[K.O_SEP]:
+        raise ParameterError(f"{name} was settled with separation_height = {settled:g} m, "
+                             f"this run has {asm.opt[K.O_SEP]:g} m: solve it again "
+                             "(rest_state of this assembly)")
+    return state

@@ -9,7 +9,7 @@ parameters of every support line and of the ship, the failure (if any), the ener
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -18,7 +18,8 @@ from shipblock.errors import ParameterError, ParameterTypeError
 from shipblock.section import _kernel as K
 from shipblock.section.exponential import StaticSteps, settled_steps, static_steps
 from shipblock.section.model import (Assembly, InitialState, NoStaticSolution, SlidesAtRest,
-                                     assemble, static_state, sunk_state, tangent_coordinates)
+                                     assemble, check_static_state, static_state, sunk_state,
+                                     tangent_coordinates)
 from shipblock.section.parameters import DockSection
 
 __all__ = ["EVENT_NAMES", "FAILURE_NAMES", "SectionResult", "SectionRunner", "rest_state",
@@ -472,6 +473,21 @@ def rest_state(asm: Assembly) -> InitialState:
     Dormand-Prince throughout), 50 and 75 of them have a static state this way, each kept still
     by the dynamics; 13 tip off their supports, 1 crushes a cap, 5 are still refused.
 
+    The settling is a full run (0.3-4 s of CPU): a caller that runs one section many times
+    solves this once and hands it to :class:`SectionRunner` (``initial_state``), as the study
+    model does (:class:`shipblock.models.section.SectionSystem` carries it).
+
+    Parameters
+    ----------
+    asm : Assembly
+        The section's assembly (its separation height stops the settling run at a separation).
+
+    Returns
+    -------
+    InitialState
+        Its ``settled_separation_height`` that of ``asm`` when the dock was left to settle,
+        else None.
+
     Raises
     ------
     NoStaticSolution, SlidesAtRest
@@ -502,13 +518,14 @@ def rest_state(asm: Assembly) -> InitialState:
     sticks = final["friction"] == K.F_STICK
     slip[sticks] -= u[sticks]
     try:
-        return static_state(asm, start=rest, slip=slip)
+        state = static_state(asm, start=rest, slip=slip)
     except (NoStaticSolution, SlidesAtRest) as exc:
         speed = float(np.abs(final["x"][3 * nb:6 * nb]).max())
         did = (f"is still moving after {REST_SECONDS:g} s (up to {speed:.2g} m/s or rad/s)"
                if speed > 1e-6 else "comes to rest")
         raise type(first)(f"{first}; left under gravity alone it {did}, and the static "
                           f"solution from there fails too: {exc}") from None
+    return replace(state, settled_separation_height=float(asm.opt[K.O_SEP]))
 
 
 class SectionRunner:
@@ -520,11 +537,24 @@ class SectionRunner:
     Parameters
     ----------
     section : DockSection
+    initial_state : InitialState, optional
+        The section's static state, :func:`rest_state` of its assembly solved once by the
+        caller (a dock that must settle first costs a full run to solve); checked against this
+        runner's assembly (:func:`~shipblock.section.model.check_static_state`: solved for an
+        equal section, settled at the same ``separation_height``), so the runs equal those from
+        the runner's own solve. Default: solved here.
     **options
         The options of :func:`simulate_section` (checked here, an unknown one a TypeError).
+
+    Raises
+    ------
+    ParameterTypeError, ParameterError
+        As :func:`simulate_section`; for an ``initial_state`` that is not this section's
+        static state at these options.
     """
 
-    def __init__(self, section: DockSection, **options):
+    def __init__(self, section: DockSection, *, initial_state: InitialState | None = None,
+                 **options):
         if not isinstance(section, DockSection):
             raise ParameterTypeError(f"section must be a DockSection, got "
                                      f"{type(section).__name__}")
@@ -532,8 +562,14 @@ class SectionRunner:
          self._expo) = _options(**options)
         self.section = section
         self._asm = assemble(section, separation)
-        self._init = rest_state(self._asm)
+        self._init = (rest_state(self._asm) if initial_state is None
+                      else check_static_state(self._asm, initial_state))
         self._steps = {}
+
+    @property
+    def initial_state(self) -> InitialState:
+        """The static state every run starts from."""
+        return self._init
 
     def __call__(self, motion, vertical=None, dt: float | None = None) -> SectionResult:
         ah, av, dt = _inputs(motion, vertical, dt)
