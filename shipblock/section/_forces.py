@@ -106,7 +106,7 @@ def _frame(x, nb, j, strip_f, strip_i):
             dy * ny + dz * nz)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def kinematics(x, nb, strip_f, strip_i, spring_f, delta, delta_dot, vt, pos):
     """Closure and closure rate of every spring, tangential slip rate of every strip at its face
     centre (:func:`contact_forces` moves it to the centre of pressure of a loaded strip).
@@ -171,7 +171,7 @@ def cap_surface(k, c, dp, dc0, t0, t):
     return dp + (dc0 - dp) * math.exp(-(k / c) * (t - t0))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def contact_forces(x, o_u, nb, strip_f, strip_i, spring_f, reg, dp, fs, delta, delta_dot, vt,
                    fe, fn, normal, tang):
     """Spring forces (total ``fn``, elastic ``fe``) and strip normal/tangential forces; the slip
