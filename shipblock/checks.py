@@ -541,6 +541,8 @@ def how_to_leave_out(keyword: str) -> str:
     """
     flag, key = READ_OPTIONS[keyword]
     return f"leave out {flag}, catalogue key {key}, Python {keyword}="
+
+
 def label(value, name: str, *, what: str = "a name") -> str:
     """``value`` checked to be a non-empty string of printable characters.
 
