@@ -261,3 +261,18 @@ def test_the_sway_panel_shows_a_small_sway_at_its_own_scale(sway_m, edges_drawn)
     else:
         assert 9.0 <= high < 12.0 and -12.0 < low <= -9.0  # the sway fills the panel
         assert labels == ["keel cap's edge at \u00b1610 mm (off scale)"]
+
+
+def test_the_load_panel_names_the_side_each_line_stands_on():
+    """Side lines are named with the side of the ship they stand on and their distance from
+    the centre line (from the dataset's ``<line>_offset``, positive to starboard), as the
+    ``simulate`` summary names them; a dataset without offsets keeps the bare names."""
+    ds = _section_histories(0.01)
+    for line in ("side0", "side1"):
+        ds[f"{line}_top_normal"] = ds["keel_top_normal"]
+        ds.attrs[f"{line}_block_capacity"] = 3.288e6
+    bare = [t.get_text() for t in plot_section_response(ds)[3].get_legend().get_texts()]
+    assert bare == ["keel", "side0", "side1", "capacity"]
+    ds.attrs.update(keel_offset=0.0, side0_offset=4.5, side1_offset=-4.5)
+    named = [t.get_text() for t in plot_section_response(ds)[3].get_legend().get_texts()]
+    assert named == ["keel", "side0 (starboard, 4.5 m)", "side1 (port, 4.5 m)", "capacity"]

@@ -577,7 +577,9 @@ class SectionRun:
         ds.attrs = {**self.summary, "failure_name": self.result.failure or "none",
                     "model": SectionModel.name, "keel_cap_half_width": sec.keel.block.half_width,
                     **{f"{name}_block_capacity": line.block.capacity
-                       for name, line in lines.items()}}
+                       for name, line in lines.items()},
+                    # where each line stands [m], positive to starboard (the figure names the side)
+                    **{f"{name}_offset": line.offset for name, line in lines.items()}}
         return ds
 
 

@@ -91,7 +91,8 @@ def plot_section_response(run, axes=None, record=None):
     for k, name in enumerate(n for n in ds.data_vars if n.endswith("_top_normal")):
         line = name[:-len("_top_normal")]
         capacity = float(ds.attrs.get(f"{line}_block_capacity", np.nan))
-        ax_n.plot(t, ds[name].values / capacity, color=f"C{k}", lw=0.9, label=line)
+        ax_n.plot(t, ds[name].values / capacity, color=f"C{k}", lw=0.9,
+                  label=_line_label(line, ds.attrs.get(f"{line}_offset")))
     ax_n.axhline(1.0, color="tab:red", lw=0.8, ls="--", label="capacity")
     ax_n.set_ylabel("load / capacity [-]")
     ax_n.legend(loc="upper right", fontsize=8, ncol=4)
@@ -111,3 +112,12 @@ def plot_section_response(run, axes=None, record=None):
     lines = ([record] if record else []) + ["dock-section model", outcome]
     fig.suptitle(wrapped(lines, SUPTITLE_WIDTH), fontsize=8.5)
     return axes
+
+
+def _line_label(line: str, offset) -> str:
+    """A support line's legend entry: a side line with the side it stands on (as the
+    ``simulate`` summary names it) and its distance from the centre line."""
+    if offset is None or line == "keel" or float(offset) == 0.0:
+        return line
+    side = "starboard" if float(offset) > 0.0 else "port"
+    return f"{line} ({side}, {abs(float(offset)):g} m)"
